@@ -1,0 +1,203 @@
+"""Static equilibrium on flat ground (spec, "Initial equilibrium").
+
+Every arm is held at the equilibrium arm angle; unknowns are the chassis height and
+pitch and the free pins. The torsion-bar free angles phi0_i (the preloads) follow from
+each arm's moment balance about its pivot, so they are eliminated from the Newton
+iteration and computed afterwards.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import layout as L
+from .kernels import allocate_neighbours, track_loads
+from .parameters import equilibrium_arm_angle, pack, total_mass
+from .reduced import allocate_work, positions
+from .terrain import flat_ground
+
+
+class EquilibriumError(RuntimeError):
+    pass
+
+
+@dataclass
+class Equilibrium:
+    q: np.ndarray              # reduced coordinates (layout.py), chassis x = 0
+    phi0: np.ndarray           # torsion-bar free angles (rad)
+    preload: np.ndarray        # torsion-bar torque on each arm at equilibrium (N m)
+    wheel_load: np.ndarray     # vertical track force on each road wheel (N)
+    tension: np.ndarray        # per link (N)
+    ground_force: float        # total vertical ground force (N)
+    weight: float              # total weight (N)
+    residual: float            # max |force residual| (N), torsion-bar moments included
+    iterations: int
+    info: dict = field(default_factory=dict)
+
+    @property
+    def chassis_height(self):
+        return float(self.q[L.Q_Y])
+
+    @property
+    def chassis_pitch(self):
+        return float(self.q[L.Q_PITCH])
+
+    def summary(self):
+        t = self.tension
+        return {
+            "chassis_height_m": self.chassis_height,
+            "chassis_pitch_rad": self.chassis_pitch,
+            "tension_mean_N": float(t.mean()),
+            "tension_max_N": float(t.max()),
+            "tension_max_link": int(t.argmax()),
+            "tension_min_N": float(t.min()),
+            "tension_min_link": int(t.argmin()),
+            "wheel_load_N": [float(v) for v in self.wheel_load],
+            "torsion_preload_Nm": [float(v) for v in self.preload],
+            "ground_force_N": self.ground_force,
+            "weight_N": self.weight,
+            "residual_N": self.residual,
+            "residual_rel": self.residual / self.weight,
+        }
+
+
+def _lower_hull(points):
+    """Lower convex hull, left to right (Andrew's monotone chain)."""
+    pts = sorted(map(tuple, points))
+    hull = []
+    for p in pts:
+        while len(hull) >= 2:
+            (x1, y1), (x2, y2) = hull[-2], hull[-1]
+            if (x2 - x1) * (p[1] - y1) - (y2 - y1) * (p[0] - x1) <= 0.0:
+                hull.pop()
+            else:
+                break
+        hull.append(p)
+    return np.array(hull)
+
+
+def initial_track(ends_world, wheel_centres, rho, n_links):
+    """Pins spread evenly along the taut path: the lower convex hull of the track ends
+    and the wheel circles of radius rho (wheel radius + pad). Pin 0 is the front end."""
+    ang = np.linspace(0.0, 2 * np.pi, 721)[:-1]
+    circ = [c + rho * np.column_stack([np.cos(ang), np.sin(ang)]) for c in wheel_centres]
+    hull = _lower_hull(np.vstack([ends_world] + circ))
+    hull = hull[::-1]  # front (largest x) to rear
+    seg = np.hypot(*np.diff(hull, axis=0).T)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    target = np.linspace(0.0, s[-1], n_links + 1)
+    pins = np.column_stack([np.interp(target, s, hull[:, 0]), np.interp(target, s, hull[:, 1])])
+    return pins, s[-1], hull
+
+
+class _Problem:
+    """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins)."""
+
+    def __init__(self, vehicle, track, gravity):
+        self.par, piv, self.ends = pack(vehicle, track, gravity)
+        self.nw = int(vehicle["n_wheels"])
+        self.n_links = int(track["n_links"])
+        self.phi = equilibrium_arm_angle(vehicle)
+        self.arms = np.column_stack([piv, np.full(self.nw, self.phi)])
+        g = flat_ground()
+        self.seg, self.corners = g.segments, g.corners
+        self.nbr, self.ref = allocate_neighbours(self.nw, 0, self.n_links, len(self.seg))
+        self.work = allocate_work(self.nw, self.n_links)
+        self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
+        self.nq = L.n_coordinates(self.nw, self.n_links)
+        self.weight = total_mass(vehicle, track) * gravity
+
+    def q_of(self, u):
+        q = np.zeros(self.nq)
+        q[L.Q_Y] = u[0]
+        q[L.Q_PITCH] = u[1]
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
+        q[L.pin_offset(self.nw):] = u[2:]
+        return q
+
+    def loads(self, q):
+        apos, avel, fpin, fwheel, wc, wv, lk, _ = self.work
+        zero = np.zeros(self.nq)
+        positions(q, zero, self.par, self.arms, self.ends, apos, avel, wc, wv)
+        track_loads(apos, avel, wc, wv, self.par, self.seg, self.corners, self.nbr, self.ref,
+                    lk, fpin, fwheel, self.diag, L.diag_tension(self.nw))
+        return apos, fpin, fwheel, wc
+
+    def residual(self, u):
+        """(vertical force, moment of chassis + arms, pin forces); and arm moments."""
+        q = self.q_of(u)
+        apos, fpin, fwheel, wc = self.loads(q)
+        g = self.par[L.P_GRAVITY]
+        ma = self.par[L.P_ARM_MASS]
+        n = self.n_links
+        xc, yc = q[L.Q_X], q[L.Q_Y]
+        fy = fpin[0, 1] + fpin[n, 1] + fwheel[:, 1].sum() - (self.par[L.P_CHASSIS_MASS] + self.nw * ma) * g
+        fx = fpin[0, 0] + fpin[n, 0] + fwheel[:, 0].sum()
+        mom = 0.0
+        for b in (0, n):
+            mom += (apos[b, 0] - xc) * fpin[b, 1] - (apos[b, 1] - yc) * fpin[b, 0]
+        wfy = fwheel[:, 1] - ma * g
+        mom += np.sum((wc[:, 0] - xc) * wfy - (wc[:, 1] - yc) * fwheel[:, 0])
+        pins = fpin[1:n].copy()
+        pins[:, 1] -= self.par[L.P_PIN_MASS] * g
+        c, s = np.cos(q[L.Q_PITCH]), np.sin(q[L.Q_PITCH])
+        piv = np.column_stack([xc + c * self.arms[:, 0] - s * self.arms[:, 1],
+                               yc + s * self.arms[:, 0] + c * self.arms[:, 1]])
+        arm_moment = (wc[:, 0] - piv[:, 0]) * wfy - (wc[:, 1] - piv[:, 1]) * fwheel[:, 0]
+        return np.concatenate([[fy, mom], pins.ravel()]), fx, arm_moment
+
+
+def solve_equilibrium(vehicle, track, gravity, tol_rel=1e-12, max_iter=60):
+    """Newton iteration with a finite-difference Jacobian and a backtracking line search."""
+    P = _Problem(vehicle, track, gravity)
+    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
+    hg = P.par[L.P_PAD_GROUND]
+    # start: wheels resting on the track, the track on the ground, chassis level
+    wcb = P.arms[:, :2] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
+    yc = -wcb[:, 1].min() + rho + hg
+    ends_w = P.ends + [0.0, yc]
+    pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
+    u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
+    r, _, _ = P.residual(u)
+    norm = np.abs(r).max()
+    target = tol_rel * P.weight
+    it = 0
+    while norm > target and it < max_iter:
+        it += 1
+        J = np.empty((u.size, u.size))
+        h = 1e-7
+        for k in range(u.size):
+            up = u.copy()
+            up[k] += h
+            um = u.copy()
+            um[k] -= h
+            J[:, k] = (P.residual(up)[0] - P.residual(um)[0]) / (2 * h)
+        du = np.linalg.solve(J, -r)
+        lam = 1.0
+        while True:
+            un = u + lam * du
+            rn, _, _ = P.residual(un)
+            nn = np.abs(rn).max()
+            if nn < norm or lam < 1e-4:
+                break
+            lam *= 0.5
+        u, r, norm = un, rn, nn
+        if lam < 1e-4 and nn >= norm:
+            break
+    if not np.isfinite(norm) or norm > 1e-6 * P.weight:
+        raise EquilibriumError(
+            f"static equilibrium not found: force residual {norm:.3g} N after {it} Newton "
+            f"iterations (needs < {1e-6 * P.weight:.3g} N); check the vehicle and track geometry")
+    r, fx, arm_moment = P.residual(u)
+    q = P.q_of(u)
+    kt = P.par[L.P_TORSION_STIFFNESS]
+    # torsion torque -k_t (phi - phi0) balances the arm's moment about its pivot
+    preload = -arm_moment
+    phi0 = q[L.Q_ARM:L.Q_ARM + P.nw] + preload / kt
+    apos, fpin, fwheel, wc = P.loads(q)
+    tension = P.diag[L.diag_tension(P.nw):L.diag_tension(P.nw) + P.n_links].copy()
+    return Equilibrium(
+        q=q, phi0=phi0, preload=preload, wheel_load=fwheel[:, 1].copy(), tension=tension,
+        ground_force=float(P.diag[L.D_GROUND_FY]), weight=P.weight,
+        residual=float(max(np.abs(r).max(), abs(fx))), iterations=it,
+        info={"pins": apos.copy(), "wheel_centres": wc.copy()})

@@ -1,0 +1,111 @@
+"""Index tables: the one place that says where each quantity lives in the arrays
+the compiled kernels share.
+
+Reduced-coordinate state ``y`` (length ``2 * nq + 1``)::
+
+    q   = y[0:nq]          generalised coordinates
+    qd  = y[nq:2*nq]       their rates
+    W   = y[2*nq]          work done by all contact forces since t = 0 (J)
+
+    q[Q_X], q[Q_Y]         chassis mass-centre position (m)
+    q[Q_PITCH]             chassis pitch, counter-clockwise (rad)
+    q[Q_ARM + i]           arm angle phi_i of road wheel i relative to the chassis (rad)
+    q[pin_offset(nw) + 2*(b-1) + k]   coordinate k (0 = x, 1 = y) of free pin b = 1..n_links-1
+
+Pins are numbered 0..n_links from the front track end to the rear one; pins 0 and
+n_links are fixed to the chassis. Link b joins pins b and b+1.
+"""
+
+# --- generalised coordinates of the reduced solver --------------------------------
+Q_X = 0
+Q_Y = 1
+Q_PITCH = 2
+Q_ARM = 3
+
+
+def pin_offset(n_wheels):
+    """Index in q of the x coordinate of free pin 1."""
+    return Q_ARM + n_wheels
+
+
+def n_coordinates(n_wheels, n_links):
+    return Q_ARM + n_wheels + 2 * (n_links - 1)
+
+
+# --- scalar parameters, ``par`` ---------------------------------------------------
+P_CHASSIS_MASS = 0
+P_CHASSIS_INERTIA = 1
+P_ARM_MASS = 2
+P_ARM_INERTIA = 3
+P_ARM_LENGTH = 4
+P_TORSION_STIFFNESS = 5
+P_WHEEL_RADIUS = 6
+P_PIN_MASS = 7
+P_LINK_LENGTH = 8
+P_LINK_STIFFNESS = 9
+P_PAD_WHEEL = 10         # h_w
+P_PAD_GROUND = 11        # h_g
+P_K_WHEEL = 12           # k_w
+P_K_GROUND = 13          # k_g
+P_GRAVITY = 14
+P_SKIN = 15              # neighbour-list margin (m); results do not depend on it
+N_PAR = 16
+
+# --- per-evaluation diagnostics, ``diag`` -------------------------------------------
+D_STATUS = 0             # 0 ok, else a Status code found in this evaluation
+D_POWER = 1              # dW/dt: power of all contact forces (W)
+D_E_TENSION = 2          # elastic energy of the links, Eq. (8) (J)
+D_E_PAD_WHEEL = 3        # energy of the wheel-side pads (J)
+D_E_PAD_GROUND = 4       # energy of the ground-side pads (J)
+D_E_TORSION = 5          # energy of the torsion bars (J)
+D_E_KINETIC = 6
+D_E_GRAVITY = 7          # gravity potential, y measured from 0 (J)
+D_GROUND_FX = 8          # total ground force on the track (N)
+D_GROUND_FY = 9
+D_CORNER_FORCE = 10      # sum of corner (obstacle edge) contact forces (N)
+D_CHASSIS_AX = 11        # chassis mass-centre acceleration (m/s^2)
+D_CHASSIS_AY = 12
+D_MIN_TENSION = 13
+D_MAX_TENSION = 14
+D_REBUILDS = 15          # neighbour-list rebuilds (cumulative, kept by the caller)
+D_WHEEL = 16             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
+
+
+def diag_tension(n_wheels):
+    """Offset of the link tensions, one per link, in diag."""
+    return D_WHEEL + 2 * n_wheels
+
+
+def n_diag(n_wheels, n_links):
+    return diag_tension(n_wheels) + n_links
+
+
+# --- peaks over every accepted step, ``peaks`` (rows: value, time) -----------------
+PK_GROUND_FY = 0         # max total vertical ground force (N)
+PK_TENSION_MAX = 1       # max link tension (N)
+PK_TENSION_MIN = 2       # min link tension (N; negative = compression)
+PK_AY_MAX = 3            # max chassis vertical acceleration (m/s^2)
+PK_AY_MIN = 4
+PK_VX_MIN = 5            # min chassis horizontal velocity (m/s)
+PK_ENERGY_BALANCE = 6    # max |paper energy balance - initial| (J)
+PK_ENERGY_RESIDUAL = 7   # max |work-based residual| (J)
+PK_FIRST_CORNER = 8      # value 1 once a ground corner touched the track; time of first touch
+PK_FIRST_COMPRESSION = 9  # value 1 once any link went into compression; time of first
+PK_WHEEL_FY = 10         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
+
+
+def n_peaks(n_wheels):
+    return PK_WHEEL_FY + n_wheels
+
+
+# --- solver statistics, ``stats`` ----------------------------------------------------
+S_STATUS = 0
+S_T_FINAL = 1
+S_STEPS = 2
+S_REJECTED = 3
+S_RHS = 4
+S_N_OUT = 5
+S_H_MIN = 6
+S_H_MAX = 7
+S_E0 = 8                 # initial total energy: kinetic + elastic (J)
+N_STATS = 9

@@ -1,0 +1,96 @@
+"""The paper's vehicle (Lee 2000, section 5, as pinned down by the model spec).
+
+``paper_vehicle()`` and ``paper_track()`` return fresh dicts so that a caller can
+change a copy without touching the defaults. ``pack()`` turns validated vehicle and
+track dicts into the arrays the compiled kernels use.
+"""
+
+import math
+
+import numpy as np
+
+from . import layout as L
+
+
+def paper_vehicle():
+    """Chassis, torsion-bar arms and road wheels (SI units, angles in degrees)."""
+    return {
+        "chassis_mass": 20000.0,          # hull + turret (kg)
+        "chassis_inertia": 47700.0,       # about the mass centre (kg m^2)
+        "arm_mass": 300.0,                # torsion-bar arm + road wheel (kg)
+        "arm_inertia": 12.5,              # about the wheel centre (kg m^2)
+        "arm_length": 0.5,                # pivot to wheel centre (m)
+        "arm_angle": 45.0,                # below the chassis x axis, trailing, at equilibrium (deg)
+        "torsion_stiffness": 191000.0,    # k_t (N m/rad)
+        "wheel_radius": 0.28,             # r (m)
+        "n_wheels": 5,
+        "first_pivot_x": 1.70,            # body point of wheel 1's torsion-bar axis (m)
+        "pivot_y": -0.20,
+        "pivot_spacing": 0.81,            # pivot i at first_pivot_x - i * spacing
+        "front_track_end": [2.54, 0.0],   # body point where pin 0 is fixed (m)
+        "rear_track_end": [-2.81, 0.0],   # body point where the last pin is fixed (m)
+    }
+
+
+def paper_track():
+    """Track links, pins, rubber pads and contact stiffnesses."""
+    return {
+        "n_links": 30,
+        "link_length": 0.19,              # L0, undeformed (m)
+        "pin_mass": 20.0,                 # each free pin (kg)
+        "link_stiffness": 8.0e6,          # k_tau, Eq. (8) (N/m)
+        "pad_wheel": 0.02,                # h_w: centre line to wheel-side surface (m)
+        "pad_ground": 0.02,               # h_g: centre line to ground-side surface (m)
+        "wheel_stiffness": 1.0e8,         # k_w, Eq. (4) (N/m)
+        "ground_stiffness": 1.0e8,        # k_g, Eq. (6) (N/m)
+    }
+
+
+GRAVITY = 9.81
+NEIGHBOUR_SKIN = 0.05  # m; only sets how often the contact lists are rebuilt
+
+
+def pivots(vehicle):
+    """Body points of the arm pivots, wheel 1 (front) first: shape (n_wheels, 2)."""
+    i = np.arange(int(vehicle["n_wheels"]))
+    return np.column_stack([vehicle["first_pivot_x"] - vehicle["pivot_spacing"] * i,
+                            np.full(i.size, vehicle["pivot_y"])])
+
+
+def equilibrium_arm_angle(vehicle):
+    """phi at the initial equilibrium: trailing arm, arm_angle below the chassis x axis."""
+    return -math.pi + math.radians(vehicle["arm_angle"])
+
+
+def wheel_centres_body(vehicle):
+    """Wheel centres in the chassis frame at the initial equilibrium."""
+    phi = equilibrium_arm_angle(vehicle)
+    return pivots(vehicle) + vehicle["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
+
+
+def pack(vehicle, track, gravity):
+    """Scalar parameter vector ``par`` (see layout.P_*) and the body-point tables."""
+    par = np.zeros(L.N_PAR)
+    par[L.P_CHASSIS_MASS] = vehicle["chassis_mass"]
+    par[L.P_CHASSIS_INERTIA] = vehicle["chassis_inertia"]
+    par[L.P_ARM_MASS] = vehicle["arm_mass"]
+    par[L.P_ARM_INERTIA] = vehicle["arm_inertia"]
+    par[L.P_ARM_LENGTH] = vehicle["arm_length"]
+    par[L.P_TORSION_STIFFNESS] = vehicle["torsion_stiffness"]
+    par[L.P_WHEEL_RADIUS] = vehicle["wheel_radius"]
+    par[L.P_PIN_MASS] = track["pin_mass"]
+    par[L.P_LINK_LENGTH] = track["link_length"]
+    par[L.P_LINK_STIFFNESS] = track["link_stiffness"]
+    par[L.P_PAD_WHEEL] = track["pad_wheel"]
+    par[L.P_PAD_GROUND] = track["pad_ground"]
+    par[L.P_K_WHEEL] = track["wheel_stiffness"]
+    par[L.P_K_GROUND] = track["ground_stiffness"]
+    par[L.P_GRAVITY] = gravity
+    par[L.P_SKIN] = NEIGHBOUR_SKIN
+    ends = np.array([vehicle["front_track_end"], vehicle["rear_track_end"]], dtype=float)
+    return par, pivots(vehicle), ends
+
+
+def total_mass(vehicle, track):
+    return (vehicle["chassis_mass"] + vehicle["n_wheels"] * vehicle["arm_mass"]
+            + (track["n_links"] - 1) * track["pin_mass"])

@@ -1,0 +1,189 @@
+"""Solver result -> xarray.Dataset (every variable documented in results_schema.md),
+and an atomic netCDF writer."""
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import __version__
+from .model import layout as L
+from .results import Result
+
+MODEL_VERSION = "1"  # bump when a change to the model or solvers changes results
+
+
+def _var(dims, data, units, long_name, **attrs):
+    return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
+
+
+def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solve_time):
+    nw, nl = model.nw, model.n_links
+    nq = L.n_coordinates(nw, nl)
+    y, d = result.y, result.diag
+    q, qd, work = y[:, :nq], y[:, nq:2 * nq], y[:, 2 * nq]
+    off = L.pin_offset(nw)
+    n = len(result.time)
+    # pins 0 and n_links ride on the chassis
+    c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
+    pin_x = np.empty((n, nl + 1))
+    pin_y = np.empty((n, nl + 1))
+    pin_x[:, 1:nl] = q[:, off::2]
+    pin_y[:, 1:nl] = q[:, off + 1::2]
+    for col, (bx, by) in ((0, model.ends[0]), (nl, model.ends[1])):
+        pin_x[:, col] = q[:, L.Q_X] + c * bx - s * by
+        pin_y[:, col] = q[:, L.Q_Y] + s * bx + c * by
+    beta = q[:, L.Q_PITCH, None] + q[:, L.Q_ARM:L.Q_ARM + nw]
+    la = model.par[L.P_ARM_LENGTH]
+    wx = q[:, L.Q_X, None] + c[:, None] * model.arms[:, 0] - s[:, None] * model.arms[:, 1] + la * np.cos(beta)
+    wy = q[:, L.Q_Y, None] + s[:, None] * model.arms[:, 0] + c[:, None] * model.arms[:, 1] + la * np.sin(beta)
+    wheel_f = d[:, L.D_WHEEL:L.D_WHEEL + 2 * nw].reshape(n, nw, 2)
+    tension = d[:, L.diag_tension(nw):L.diag_tension(nw) + nl]
+    elastic = d[:, L.D_E_TORSION] + d[:, L.D_E_TENSION] + d[:, L.D_E_PAD_WHEEL] + d[:, L.D_E_PAD_GROUND]
+    grav = d[:, L.D_E_GRAVITY] - d[0, L.D_E_GRAVITY]
+    kin = d[:, L.D_E_KINETIC]
+    e0 = result.stats[L.S_E0]
+    balance = kin + elastic + grav
+    residual = (kin + d[:, L.D_E_TORSION] + d[:, L.D_E_TENSION] + grav - work)
+    residual = residual - residual[0]
+    T, W, P, K = ("time",), ("time", "wheel"), ("time", "pin"), ("time", "link")
+    v = {
+        "chassis_x": _var(T, q[:, L.Q_X], "m", "chassis mass-centre x"),
+        "chassis_y": _var(T, q[:, L.Q_Y], "m", "chassis mass-centre height"),
+        "chassis_pitch": _var(T, q[:, L.Q_PITCH], "rad", "chassis pitch, positive raises the front"),
+        "chassis_vx": _var(T, qd[:, L.Q_X], "m s-1", "chassis mass-centre horizontal velocity"),
+        "chassis_vy": _var(T, qd[:, L.Q_Y], "m s-1", "chassis mass-centre vertical velocity"),
+        "chassis_ax": _var(T, d[:, L.D_CHASSIS_AX], "m s-2", "chassis mass-centre horizontal acceleration"),
+        "chassis_ay": _var(T, d[:, L.D_CHASSIS_AY], "m s-2", "chassis mass-centre vertical acceleration"),
+        "arm_angle": _var(W, q[:, L.Q_ARM:L.Q_ARM + nw], "rad",
+                          "torsion-bar arm angle phi (pivot to wheel centre) relative to the chassis x axis"),
+        "wheel_x": _var(W, wx, "m", "road-wheel centre x"),
+        "wheel_y": _var(W, wy, "m", "road-wheel centre y"),
+        "wheel_force_x": _var(W, wheel_f[:, :, 0], "N", "horizontal wheel-track contact force on the wheel"),
+        "wheel_force_y": _var(W, wheel_f[:, :, 1], "N", "vertical wheel-track contact force on the wheel"),
+        "ground_force_x": _var(T, d[:, L.D_GROUND_FX], "N", "total horizontal ground force on the track"),
+        "ground_force_y": _var(T, d[:, L.D_GROUND_FY], "N", "total vertical ground force on the track"),
+        "obstacle_force": _var(T, d[:, L.D_CORNER_FORCE], "N", "sum of the ground-corner contact forces"),
+        "pin_x": _var(P, pin_x, "m", "track pin x (pins 0 and last fixed to the chassis)"),
+        "pin_y": _var(P, pin_y, "m", "track pin y"),
+        "link_tension": _var(K, tension, "N", "link tension, Eq. (8); negative is compression"),
+        "energy_kinetic": _var(T, kin, "J", "kinetic energy"),
+        "energy_elastic": _var(T, elastic, "J", "elastic energy: torsion bars, links, wheel and ground pads"),
+        "energy_gravity": _var(T, grav, "J", "gravity potential relative to t = 0"),
+        "energy_balance": _var(T, balance, "J", "paper's energy balance: kinetic + elastic + gravity potential"),
+        "energy_balance_error": _var(T, (balance - balance[0]) / e0, "1",
+                                     "energy balance deviation relative to the initial total energy"),
+        "contact_work": _var(T, work, "J", "work done by all contact forces since t = 0"),
+        "energy_residual": _var(T, residual / e0, "1",
+                                "work-based residual: kinetic + torsion + tension + gravity - contact work, "
+                                "change since t = 0 relative to the initial total energy"),
+    }
+    pk = result.peaks
+    v["peak_wheel_force_y"] = _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 0], "N",
+                                   "max vertical wheel-track force over all accepted steps")
+    v["peak_wheel_force_y_time"] = _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 1], "s",
+                                        "time of peak_wheel_force_y")
+
+    def scalar(name, row, units, text, scale=1.0):
+        v[name] = _var((), pk[row, 0] * scale, units, text + " over all accepted steps")
+        v[name + "_time"] = _var((), pk[row, 1], "s", "time of " + name)
+
+    scalar("peak_ground_force_y", L.PK_GROUND_FY, "N", "max total vertical ground force")
+    scalar("peak_link_tension", L.PK_TENSION_MAX, "N", "max link tension")
+    scalar("min_link_tension", L.PK_TENSION_MIN, "N", "min link tension")
+    scalar("peak_chassis_ay", L.PK_AY_MAX, "m s-2", "max chassis vertical acceleration")
+    scalar("min_chassis_ay", L.PK_AY_MIN, "m s-2", "min chassis vertical acceleration")
+    scalar("min_chassis_vx", L.PK_VX_MIN, "m s-1", "min chassis horizontal velocity")
+    scalar("max_energy_balance_error", L.PK_ENERGY_BALANCE, "1", "max |energy balance deviation| / E0", 1 / e0)
+    scalar("max_energy_residual", L.PK_ENERGY_RESIDUAL, "1", "max |work-based energy residual| / E0", 1 / e0)
+    first = pk[L.PK_FIRST_CORNER, 1] if pk[L.PK_FIRST_CORNER, 0] > 0 else np.nan
+    comp = pk[L.PK_FIRST_COMPRESSION, 1] if pk[L.PK_FIRST_COMPRESSION, 0] > 0 else np.nan
+    v["first_contact_time"] = _var((), first, "s", "first accepted step with a ground corner touching the track")
+    v["first_compression_time"] = _var((), comp, "s", "first accepted step with a link in compression "
+                                       "(after it the motion is sensitive, see results_schema.md)")
+    for name, arr in result.extra.items():
+        v[name] = arr
+    coords = {
+        "time": _var(T, result.time, "s", "simulated time"),
+        "wheel": _var(("wheel",), np.arange(1, nw + 1), "1", "road wheel number, 1 = front"),
+        "pin": _var(("pin",), np.arange(nl + 1), "1", "track pin number, 0 = front track end"),
+        "link": _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1)"),
+    }
+    st = result.stats
+    status = Result(int(st[L.S_STATUS]))
+    attrs = {
+        "Conventions": "CF-1.11",
+        "title": f"trackbench run: {scenario.name}",
+        "trackbench_version": __version__,
+        "model_version": MODEL_VERSION,
+        "status": "completed" if status == Result.SUCCESSFUL else "failed",
+        "status_code": int(status),
+        "status_message": status.message,
+        "t_final": float(st[L.S_T_FINAL]),
+        "solver": scenario["solver"],
+        "method": scenario["method"] if scenario["solver"] == "reduced" else "lee-rkn",
+        "tolerance": scenario["tolerance"],
+        "steps": int(st[L.S_STEPS]),
+        "rejected_steps": int(st[L.S_REJECTED]),
+        "rhs_evaluations": int(st[L.S_RHS]),
+        "min_step": float(st[L.S_H_MIN]),
+        "max_step": float(st[L.S_H_MAX]),
+        "neighbour_rebuilds": int(model.nbr[-1, 0]),
+        "wall_time": wall_time,
+        "solve_time": solve_time,
+        "initial_total_energy": float(e0),
+        "weight": float(model.weight),
+        "scenario": json.dumps(scenario.to_dict(), sort_keys=True),
+        "terrain_resolved": json.dumps(resolved),
+        "ground_vertices": json.dumps(np.round(ground.vertices, 12).tolist()),
+        "equilibrium": json.dumps(eq.summary()),
+        "arm_pivots": json.dumps(model.arms[:, :2].tolist()),
+        "track_ends": json.dumps(model.ends.tolist()),
+        "wheel_radius": float(model.par[L.P_WHEEL_RADIUS]),
+        "arm_length": float(la),
+        "pad_wheel": float(model.par[L.P_PAD_WHEEL]),
+        "pad_ground": float(model.par[L.P_PAD_GROUND]),
+    }
+    return xr.Dataset(v, coords=coords, attrs=attrs)
+
+
+def write_netcdf(ds, path):
+    """Write to a temporary file in the target folder, then rename into place (atomic)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    enc = {k: {"zlib": True, "complevel": 4, "shuffle": True}
+           for k, var in ds.data_vars.items() if var.ndim >= 1}
+    for k in ds.coords:
+        enc[k] = {"_FillValue": None}
+    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+    return path
+
+
+def summary_numbers(ds):
+    """The one-screen summary of a run, as a dict of plain numbers."""
+    out = {"status": ds.attrs["status"]}
+    for w, f in zip(ds["wheel"].values, ds["peak_wheel_force_y"].values):
+        out[f"peak_wheel{int(w)}_force_y_kN"] = float(f) / 1e3
+    out["peak_ground_force_y_kN"] = float(ds["peak_ground_force_y"]) / 1e3
+    out["peak_link_tension_kN"] = float(ds["peak_link_tension"]) / 1e3
+    out["peak_chassis_ay"] = float(ds["peak_chassis_ay"])
+    out["min_chassis_ay"] = float(ds["min_chassis_ay"])
+    out["min_chassis_vx"] = float(ds["min_chassis_vx"])
+    out["first_contact_time"] = float(ds["first_contact_time"])
+    out["first_compression_time"] = float(ds["first_compression_time"])
+    out["max_energy_balance_error"] = float(ds["max_energy_balance_error"])
+    out["max_energy_residual"] = float(ds["max_energy_residual"])
+    out["steps"] = ds.attrs["steps"]
+    out["wall_time"] = ds.attrs["wall_time"]
+    return out

@@ -1,0 +1,37 @@
+"""Why a run stopped: integer codes the compiled loops return, each with a readable message."""
+
+from enum import IntEnum
+
+
+class Result(IntEnum):
+    SUCCESSFUL = 0
+    NAN = 1
+    STEP_SIZE_UNDERFLOW = 2
+    WHEEL_THROUGH_TRACK = 3
+    CORNER_THROUGH_TRACK = 4
+    MAX_STEPS = 5
+    CONSTRAINT_ITERATION = 6
+
+    @property
+    def message(self) -> str:
+        return _MESSAGES[self]
+
+
+_MESSAGES = {
+    Result.SUCCESSFUL: "run completed",
+    Result.NAN: "the state became NaN or infinite (diverged)",
+    Result.STEP_SIZE_UNDERFLOW: "the step size fell below the minimum step (the solution is too stiff or discontinuous here)",
+    Result.WHEEL_THROUGH_TRACK: "a road wheel went through the track (wheel centre crossed a link's centre line)",
+    Result.CORNER_THROUGH_TRACK: "a ground corner went through the track (corner crossed a link's centre line)",
+    Result.MAX_STEPS: "the maximum number of steps was reached",
+    Result.CONSTRAINT_ITERATION: "the Lagrange-multiplier iteration did not converge",
+}
+
+# plain ints for use inside numba kernels
+SUCCESSFUL = int(Result.SUCCESSFUL)
+NAN = int(Result.NAN)
+STEP_SIZE_UNDERFLOW = int(Result.STEP_SIZE_UNDERFLOW)
+WHEEL_THROUGH_TRACK = int(Result.WHEEL_THROUGH_TRACK)
+CORNER_THROUGH_TRACK = int(Result.CORNER_THROUGH_TRACK)
+MAX_STEPS = int(Result.MAX_STEPS)
+CONSTRAINT_ITERATION = int(Result.CONSTRAINT_ITERATION)

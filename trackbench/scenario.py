@@ -1,0 +1,358 @@
+"""What one run is: vehicle + track + terrain + run settings, validated before anything runs.
+
+A scenario is a nested dict with dotted names (``speed``, ``vehicle.chassis_mass``,
+``terrain.height``); ``Scenario.from_dict`` fills every missing value from the
+paper's run and raises ``ScenarioError`` (one line, naming the parameter and what is
+allowed) on anything wrong.
+"""
+
+import copy
+import difflib
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model.parameters import GRAVITY, paper_track, paper_vehicle, wheel_centres_body
+
+SOLVERS = ("reduced", "lee")
+METHODS = ("dop853", "dopri5")
+TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
+OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
+
+
+class ScenarioError(ValueError):
+    """Bad scenario input; the message is one line naming the culprit."""
+
+
+def paper_step():
+    """The paper's run: 10 m/s over a 0.1 m step first touched at t = 0.0568 s."""
+    return {
+        "name": "paper_step",
+        "speed": 10.0,
+        "duration": 0.5,
+        "gravity": GRAVITY,
+        "solver": "reduced",
+        "method": "dop853",
+        "tolerance": 1e-9,
+        "output_interval": 1e-4,
+        "max_steps": 2_000_000,
+        "perturbation": 0.0,     # m: seeded nudge of the free pins (study replicates)
+        "seed": 0,
+        "vehicle": paper_vehicle(),
+        "track": paper_track(),
+        "terrain": {"kind": "step", "height": 0.1, "first_contact_time": 0.0568},
+        "lee": {"accel_order": 10, "eps_iterations": 10, "position_tol": 1e-9,
+                "max_iterations": 500},
+        "record": {"enabled": True, "every": 1},
+    }
+
+
+# name -> (type, low, high, what is allowed). Bounds are exclusive where marked by the text.
+_POS = (float, 0.0, math.inf, "a number > 0")
+RULES = {
+    "name": (str, None, None, "a text"),
+    "speed": (float, 0.0, 100.0, "a number in [0, 100] m/s"),
+    "duration": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
+    "gravity": (float, 0.0, 100.0, "a number in [0, 100] m/s^2"),
+    "solver": (str, SOLVERS, None, "one of " + ", ".join(SOLVERS)),
+    "method": (str, METHODS, None, "one of " + ", ".join(METHODS)),
+    "tolerance": (float, 1e-14, 1e-3, "a number in [1e-14, 1e-3]"),
+    "output_interval": _POS,
+    "max_steps": (int, 1, 10**9, "an integer >= 1"),
+    "perturbation": (float, 0.0, 1e-3, "a number in [0, 1e-3] m"),
+    "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
+    "vehicle.chassis_mass": _POS,
+    "vehicle.chassis_inertia": _POS,
+    "vehicle.arm_mass": _POS,
+    "vehicle.arm_inertia": _POS,
+    "vehicle.arm_length": _POS,
+    "vehicle.arm_angle": (float, 0.0, 90.0, "a number in (0, 90) deg"),
+    "vehicle.torsion_stiffness": _POS,
+    "vehicle.wheel_radius": _POS,
+    "vehicle.n_wheels": (int, 1, 20, "an integer in [1, 20]"),
+    "vehicle.first_pivot_x": (float, -math.inf, math.inf, "a finite number (m)"),
+    "vehicle.pivot_y": (float, -math.inf, math.inf, "a finite number (m)"),
+    "vehicle.pivot_spacing": _POS,
+    "vehicle.front_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
+    "vehicle.rear_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
+    "track.n_links": (int, 4, 400, "an integer in [4, 400]"),
+    "track.link_length": _POS,
+    "track.pin_mass": _POS,
+    "track.link_stiffness": _POS,
+    "track.pad_wheel": _POS,
+    "track.pad_ground": _POS,
+    "track.wheel_stiffness": _POS,
+    "track.ground_stiffness": _POS,
+    "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
+    "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
+    "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
+    "lee.max_iterations": (int, 1, 100000, "an integer >= 1"),
+    "record.enabled": (bool, None, None, "true or false"),
+    "record.every": (int, 1, 10**6, "an integer >= 1"),
+}
+_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle"} | {
+    k for k, r in RULES.items() if r is _POS}
+
+TERRAIN_RULES = {
+    "kind": (str, TERRAIN_KINDS, None, "one of " + ", ".join(TERRAIN_KINDS)),
+    "height": (float, 0.0, 10.0, "a number in (0, 10] m"),
+    "length": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
+    "position": (float, -900.0, 900.0, "a number in [-900, 900] m (x of the obstacle's start)"),
+    "first_contact_time": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
+    "gap": (float, 0.0, 1000.0, "a number in [0, 1000] m"),
+    "points": (list, None, None, "a list of [x, y] pairs with x non-decreasing"),
+    "obstacles": (list, None, None, "a list of obstacle tables"),
+}
+_TERRAIN_KEYS = {
+    "flat": set(),
+    "step": {"height", "position", "first_contact_time"},
+    "ramp": {"height", "length", "position"},
+    "block": {"height", "length", "position", "first_contact_time"},
+    "bump": {"height", "length", "position"},
+    "points": {"points"},
+    "sequence": {"obstacles"},
+}
+_OBSTACLE_KEYS = {"step": {"height", "position", "gap", "first_contact_time"},
+                  "ramp": {"height", "length", "position", "gap"},
+                  "block": {"height", "length", "position", "gap", "first_contact_time"},
+                  "bump": {"height", "length", "position", "gap"}}
+
+
+def parameter_names():
+    """Every dotted name a scenario accepts (terrain keys included)."""
+    return sorted(RULES) + sorted("terrain." + k for k in TERRAIN_RULES)
+
+
+def _unknown(name, valid):
+    close = difflib.get_close_matches(name, valid, n=3, cutoff=0.5)
+    hint = f"; did you mean {', '.join(close)}?" if close else "; see `trackbench params` for the list"
+    return ScenarioError(f"unknown parameter '{name}'{hint}")
+
+
+def _check_value(name, value, rule, open_low=False):
+    typ, lo, hi, allowed = rule
+    bad = ScenarioError(f"{name} = {value!r} is not allowed: expected {allowed}")
+    if typ is bool:
+        if not isinstance(value, bool):
+            raise bad
+        return value
+    if typ is str:
+        if not isinstance(value, str) or (lo is not None and value not in lo):
+            raise bad
+        return value
+    if typ is list:
+        if not isinstance(value, (list, tuple)):
+            raise bad
+        return [list(v) if isinstance(v, (list, tuple)) else v for v in value]
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise bad
+    if typ is int:
+        if float(value) != int(value):
+            raise bad
+        value = int(value)
+    else:
+        value = float(value)
+    if not math.isfinite(value) and not (math.isinf(value) and math.isinf(hi)):
+        raise bad
+    if not (lo <= value <= hi) or (open_low and value <= lo):
+        raise bad
+    return value
+
+
+def set_dotted(d, name, value):
+    """Set d['a']['b'] for name 'a.b', creating tables on the way."""
+    parts = name.split(".")
+    for p in parts[:-1]:
+        d = d.setdefault(p, {})
+    d[parts[-1]] = value
+
+
+def flatten(d, prefix=""):
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict) and not (prefix + k).startswith("terrain"):
+            out.update(flatten(v, prefix + k + "."))
+        else:
+            out[prefix + k] = v
+    return out
+
+
+def _merge(base, over, prefix=""):
+    for k, v in over.items():
+        name = prefix + k
+        if k not in base and not name.startswith("terrain"):
+            raise _unknown(name, parameter_names())
+        if name == "terrain":
+            if not isinstance(v, dict):
+                raise ScenarioError("terrain must be a table, e.g. {kind = \"step\", height = 0.1}")
+            if "kind" in v and v["kind"] != base["terrain"].get("kind"):
+                base["terrain"] = {}  # a new kind starts from nothing
+            base["terrain"].update(copy.deepcopy(v))
+        elif isinstance(base.get(k), dict):
+            if not isinstance(v, dict):
+                raise ScenarioError(f"{name} is a group of parameters, not a value; set e.g. {name}.{next(iter(base[k]))}")
+            _merge(base[k], v, name + ".")
+        else:
+            base[k] = copy.deepcopy(v)
+
+
+def _validate_obstacle(ob, where, first):
+    if not isinstance(ob, dict):
+        raise ScenarioError(f"{where} must be a table like {{kind = \"step\", height = 0.1, position = 5.0}}")
+    kind = _check_value(where + ".kind", ob.get("kind"), (str, OBSTACLE_KINDS, None,
+                        "one of " + ", ".join(OBSTACLE_KINDS)))
+    allowed = _OBSTACLE_KEYS[kind] if where != "terrain" else _TERRAIN_KEYS[kind]
+    out = {"kind": kind}
+    for k, v in ob.items():
+        if k == "kind":
+            continue
+        if k not in allowed:
+            raise ScenarioError(f"{where}.{k} does not apply to a {kind}; allowed: {', '.join(sorted(allowed))}")
+        out[k] = _check_value(f"{where}.{k}", v, TERRAIN_RULES[k],
+                              open_low=k in ("height", "length", "first_contact_time"))
+    for need in ("height",) + (("length",) if kind != "step" else ()):
+        if need not in out:
+            raise ScenarioError(f"{where}.{need} is missing: a {kind} needs {need}")
+    placed = [k for k in ("position", "gap", "first_contact_time") if k in out]
+    if len(placed) > 1:
+        raise ScenarioError(f"{where}: give only one of {', '.join(placed)}")
+    if not placed:
+        if first and "first_contact_time" in allowed:
+            out["first_contact_time"] = 0.0568
+        elif first:
+            raise ScenarioError(f"{where}.position is missing: a {kind} needs the x of its start")
+        else:
+            raise ScenarioError(f"{where}: give position or gap")
+    if not first and "first_contact_time" in out:
+        raise ScenarioError(f"{where}.first_contact_time: only the first obstacle can be placed by time")
+    if first and "gap" in out:
+        raise ScenarioError(f"{where}.gap: the first obstacle needs position or first_contact_time")
+    return out
+
+
+def validate_terrain(t):
+    kind = _check_value("terrain.kind", t.get("kind"), TERRAIN_RULES["kind"])
+    if kind == "flat":
+        extra = set(t) - {"kind"}
+        if extra:
+            raise ScenarioError(f"terrain.{sorted(extra)[0]} does not apply to flat ground")
+        return {"kind": "flat"}
+    if kind == "points":
+        for k in t:
+            if k not in ("kind", "points"):
+                raise ScenarioError(f"terrain.{k} does not apply to kind 'points'; give terrain.points = [[x, y], ...]")
+        pts = t.get("points")
+        try:
+            arr = np.asarray(pts, dtype=float)
+        except (TypeError, ValueError):
+            arr = np.zeros((0, 3))
+        if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 2 or not np.all(np.isfinite(arr)):
+            raise ScenarioError("terrain.points must be a list of at least two [x, y] pairs of finite numbers")
+        if np.any(np.diff(arr[:, 0]) < 0):
+            i = int(np.nonzero(np.diff(arr[:, 0]) < 0)[0][0]) + 1
+            raise ScenarioError(f"terrain.points[{i}] has x = {arr[i, 0]} < the previous x: x must be non-decreasing")
+        if np.any(np.abs(arr) > 900):
+            raise ScenarioError("terrain.points must lie within |x|, |y| <= 900 m")
+        return {"kind": "points", "points": arr.tolist()}
+    if kind == "sequence":
+        obs = t.get("obstacles")
+        extra = set(t) - {"kind", "obstacles"}
+        if extra:
+            raise ScenarioError(f"terrain.{sorted(extra)[0]} does not apply to a sequence; put it into terrain.obstacles")
+        if not isinstance(obs, list) or not obs:
+            raise ScenarioError("terrain.obstacles must be a non-empty list of obstacle tables")
+        return {"kind": "sequence", "obstacles": [
+            _validate_obstacle(o, f"terrain.obstacles[{i}]", i == 0) for i, o in enumerate(obs)]}
+    return _validate_obstacle(t, "terrain", True)
+
+
+def _check_geometry(v, tr):
+    """Does the track fit the wheels? Cheap checks on the equilibrium configuration."""
+    from .model.equilibrium import initial_track
+    wc = wheel_centres_body(v)
+    r = v["wheel_radius"]
+    rho = r + tr["pad_wheel"]
+    if v["n_wheels"] > 1 and v["pivot_spacing"] <= 2 * r:
+        raise ScenarioError(f"vehicle.pivot_spacing = {v['pivot_spacing']} m makes neighbouring road wheels overlap: "
+                            f"it must exceed 2 * wheel_radius = {2 * r} m")
+    for key in ("front_track_end", "rear_track_end"):
+        e = v[key]
+        if len(e) != 2 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in e):
+            raise ScenarioError(f"vehicle.{key} must be a pair [x, y] of finite numbers (m)")
+    ends = np.array([v["front_track_end"], v["rear_track_end"]], float)
+    if not (ends[0, 0] > wc[:, 0].max() + rho and ends[1, 0] < wc[:, 0].min() - rho):
+        raise ScenarioError("vehicle.front_track_end / rear_track_end must lie ahead of the first and behind the "
+                            "last road wheel (wheel radius and pad included)")
+    if np.any(ends[:, 1] <= wc[:, 1].min() - rho + tr["pad_ground"]):
+        raise ScenarioError("vehicle.front_track_end / rear_track_end must lie above the bottom of the road wheels")
+    _, path, _ = initial_track(ends, wc, rho, tr["n_links"])
+    free = tr["n_links"] * tr["link_length"]
+    strain = path / free - 1.0
+    if strain <= 0.0:
+        raise ScenarioError(f"the track is too long for the wheels: n_links * link_length = {free:.4g} m but the path "
+                            f"around the wheels is {path:.4g} m; allowed: a total link length below {path:.4g} m")
+    if strain > 0.1:
+        raise ScenarioError(f"the track is too short for the wheels: the links would stretch {100 * strain:.3g} % "
+                            f"(n_links * link_length = {free:.4g} m, path {path:.4g} m); allowed: at most 10 %")
+    if tr["link_length"] <= 2 * tr["pad_ground"]:
+        raise ScenarioError("track.link_length must exceed 2 * track.pad_ground")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated, fully resolved scenario. Build with from_dict or paper()."""
+    data: dict
+
+    @classmethod
+    def paper(cls, **overrides):
+        return cls.from_dict(overrides)
+
+    @classmethod
+    def from_dict(cls, overrides=None, base=None):
+        """Defaults (the paper's run, or ``base``) updated by ``overrides``; keys may be
+        nested tables or dotted names."""
+        d = copy.deepcopy(base if base is not None else paper_step())
+        nested = {}
+        for k, v in (overrides or {}).items():
+            if not isinstance(k, str):
+                raise ScenarioError(f"parameter names must be text, got {k!r}")
+            if "." in k and not k.startswith("terrain."):
+                if k not in RULES:
+                    raise _unknown(k, parameter_names())
+            set_dotted(nested, k, v)
+        _merge(d, nested)
+        return cls(validate(d))
+
+    def with_overrides(self, overrides):
+        return Scenario.from_dict(overrides, base=self.data)
+
+    def to_dict(self):
+        return copy.deepcopy(self.data)
+
+    def __getitem__(self, name):
+        d = self.data
+        for p in name.split("."):
+            d = d[p]
+        return d
+
+    @property
+    def name(self):
+        return self.data["name"]
+
+
+def validate(d):
+    out = copy.deepcopy(d)
+    flat = flatten({k: v for k, v in d.items() if k != "terrain"})
+    for name, value in flat.items():
+        if name not in RULES:
+            raise _unknown(name, parameter_names())
+        set_dotted(out, name, _check_value(name, value, RULES[name], name in _OPEN_LOW))
+    out["terrain"] = validate_terrain(d["terrain"])
+    if out["output_interval"] > out["duration"]:
+        raise ScenarioError(f"output_interval = {out['output_interval']} s is longer than duration = "
+                            f"{out['duration']} s; allowed: (0, duration]")
+    if out["duration"] / out["output_interval"] > 2_000_000:
+        raise ScenarioError("output_interval is too small for this duration: at most 2,000,000 output samples")
+    _check_geometry(out["vehicle"], out["track"])
+    return out

@@ -1,0 +1,141 @@
+"""scenario -> xarray.Dataset: the one entry point the CLI, the studies and the API use.
+
+    ds = trackbench.simulate(Scenario.paper(speed=15.0))
+"""
+
+import functools
+import json
+import time
+
+import numpy as np
+
+from .model import layout as L
+from .model.equilibrium import solve_equilibrium
+from .model.kernels import allocate_neighbours
+from .model.parameters import pack, total_mass
+from .model.reduced import allocate_work
+from .model.terrain import FAR, ground_from_points, obstacle_points
+from .output import build_dataset
+from .scenario import Scenario
+
+
+@functools.lru_cache(maxsize=32)
+def _equilibrium_cached(key):
+    vehicle, track, gravity = json.loads(key)
+    return solve_equilibrium(vehicle, track, gravity)
+
+
+def equilibrium(scenario: Scenario):
+    """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
+    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"]], sort_keys=True)
+    return _equilibrium_cached(key)
+
+
+def contact_x(eq, height, pad_ground):
+    """x* of the spec: the largest x at which the resting track's ground-side surface
+    (links offset by h_g along the outer normal, circles of radius h_g at pins bent
+    convex towards the ground) is at the given height."""
+    a = eq.info["pins"]
+    best = -np.inf
+    t = np.diff(a, axis=0)
+    t /= np.hypot(t[:, 0], t[:, 1])[:, None]
+    n_out = np.column_stack([-t[:, 1], t[:, 0]])  # -n_inner
+    for b in range(len(t)):
+        p0 = a[b] + pad_ground * n_out[b]
+        p1 = a[b + 1] + pad_ground * n_out[b]
+        lo, hi = sorted((p0[1], p1[1]))
+        if lo <= height <= hi and p1[1] != p0[1]:
+            u = (height - p0[1]) / (p1[1] - p0[1])
+            best = max(best, p0[0] + u * (p1[0] - p0[0]))
+    for b in range(1, len(a) - 1):
+        if t[b - 1, 0] * t[b, 1] - t[b - 1, 1] * t[b, 0] < 0.0:  # convex towards the ground
+            dy = height - a[b, 1]
+            if abs(dy) <= pad_ground:
+                best = max(best, a[b, 0] + np.sqrt(pad_ground ** 2 - dy ** 2))
+    if not np.isfinite(best):
+        raise ValueError(f"the resting track never reaches height {height} m: the obstacle cannot be placed by "
+                         "first_contact_time; give terrain.position instead")
+    return float(best)
+
+
+def build_ground(scenario: Scenario, eq):
+    """Terrain polyline of the scenario, with obstacles placed by time resolved."""
+    t = scenario["terrain"]
+    if t["kind"] == "flat":
+        return ground_from_points([[-FAR, 0.0], [FAR, 0.0]]), {}
+    if t["kind"] == "points":
+        return ground_from_points(t["points"]), {}
+    obstacles = t["obstacles"] if t["kind"] == "sequence" else [t]
+    pts = [[-FAR, 0.0]]
+    level = 0.0
+    x_end = -FAR
+    resolved = {}
+    for i, ob in enumerate(obstacles):
+        if "first_contact_time" in ob:
+            x = contact_x(eq, ob["height"], scenario["track.pad_ground"]) + scenario["speed"] * ob["first_contact_time"]
+            resolved[f"obstacle_{i}_position"] = x
+        elif "gap" in ob:
+            x = x_end + ob["gap"]
+        else:
+            x = ob["position"]
+        if x < x_end:
+            raise ValueError(f"terrain obstacle {i} starts at x = {x:.4g} m, before the previous one ends "
+                             f"({x_end:.4g} m)")
+        new = [[px, py + level] for px, py in obstacle_points(ob["kind"], x, ob["height"], ob.get("length", 0.0))]
+        pts += new
+        x_end = new[-1][0]
+        if ob["kind"] in ("step", "ramp"):
+            level += ob["height"]
+    pts.append([FAR, level])
+    return ground_from_points(pts), resolved
+
+
+def initial_state(scenario: Scenario, eq):
+    """y0 = (q, qd, W): the equilibrium moving at `speed`, pins nudged if asked."""
+    nq = eq.q.size
+    y0 = np.zeros(2 * nq + 1)
+    y0[:nq] = eq.q
+    nw = scenario["vehicle.n_wheels"]
+    off = L.pin_offset(nw)
+    y0[nq + L.Q_X] = scenario["speed"]
+    y0[nq + off:2 * nq:2] = scenario["speed"]
+    if scenario["perturbation"] > 0.0:
+        rng = np.random.default_rng(scenario["seed"])
+        y0[off:nq] += scenario["perturbation"] * rng.uniform(-1.0, 1.0, nq - off)
+    return y0
+
+
+class Model:
+    """The compiled-kernel arrays of one scenario (see model/layout.py)."""
+
+    def __init__(self, scenario: Scenario, eq, ground):
+        v, tr = scenario["vehicle"], scenario["track"]
+        self.par, piv, self.ends = pack(v, tr, scenario["gravity"])
+        self.nw = int(v["n_wheels"])
+        self.n_links = int(tr["n_links"])
+        self.arms = np.ascontiguousarray(np.column_stack([piv, eq.phi0]))
+        self.seg = ground.segments
+        self.corners = ground.corners
+        self.nbr, self.ref = allocate_neighbours(self.nw, len(self.corners), self.n_links, len(self.seg))
+        self.work = allocate_work(self.nw, self.n_links)
+        self.weight = total_mass(v, tr) * scenario["gravity"]
+
+
+def simulate(scenario: Scenario, progress=None):
+    """Run one scenario; returns the Dataset (attrs['status'] is 'completed' or 'failed')."""
+    if not isinstance(scenario, Scenario):
+        scenario = Scenario.from_dict(scenario)
+    t_wall = time.perf_counter()
+    eq = equilibrium(scenario)
+    ground, resolved = build_ground(scenario, eq)
+    model = Model(scenario, eq, ground)
+    y0 = initial_state(scenario, eq)
+    if scenario["solver"] == "lee":
+        from .solvers.lee import run as run_solver
+    else:
+        from .solvers.rk import run as run_solver
+    t_solve = time.perf_counter()
+    result = run_solver(scenario, model, y0)
+    solve_wall = time.perf_counter() - t_solve
+    return build_dataset(scenario, model, eq, ground, resolved, result,
+                         wall_time=time.perf_counter() - t_wall, solve_time=solve_wall)

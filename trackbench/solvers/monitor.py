@@ -1,0 +1,112 @@
+"""What every solver does at an accepted step: update the peaks (so no impulse between
+output samples is missed) and fill output samples by Hermite interpolation."""
+
+import numpy as np
+from numba import njit
+
+from ..model.layout import (
+    D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
+    D_E_TENSION, D_E_TORSION, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_WHEEL,
+    PK_AY_MAX, PK_AY_MIN, PK_ENERGY_BALANCE, PK_ENERGY_RESIDUAL, PK_FIRST_COMPRESSION,
+    PK_FIRST_CORNER, PK_GROUND_FY, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
+)
+
+
+@njit(cache=True)
+def energy_balance(diag):
+    """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
+    return (diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_PAD_WHEEL]
+            + diag[D_E_PAD_GROUND] + diag[D_E_GRAVITY])
+
+
+@njit(cache=True)
+def energy_residual(diag, work):
+    """Kinetic + torsion + tension + gravity - work of the contact forces (continuous)."""
+    return diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_GRAVITY] - work
+
+
+@njit(cache=True)
+def init_peaks(peaks):
+    peaks[:, 0] = -np.inf
+    peaks[:, 1] = np.nan
+    peaks[PK_TENSION_MIN, 0] = np.inf
+    peaks[PK_AY_MIN, 0] = np.inf
+    peaks[PK_VX_MIN, 0] = np.inf
+    peaks[PK_FIRST_CORNER, 0] = 0.0
+    peaks[PK_FIRST_COMPRESSION, 0] = 0.0
+    peaks[PK_ENERGY_BALANCE, 0] = 0.0
+    peaks[PK_ENERGY_RESIDUAL, 0] = 0.0
+
+
+@njit(cache=True, inline="always")
+def _up(peaks, k, v, t):
+    if v > peaks[k, 0]:
+        peaks[k, 0] = v
+        peaks[k, 1] = t
+
+
+@njit(cache=True, inline="always")
+def _down(peaks, k, v, t):
+    if v < peaks[k, 0]:
+        peaks[k, 0] = v
+        peaks[k, 1] = t
+
+
+@njit(cache=True)
+def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
+    """e_ref, r_ref: energy balance and residual at t = 0."""
+    nw = peaks.shape[0] - PK_WHEEL_FY
+    for i in range(nw):
+        _up(peaks, PK_WHEEL_FY + i, diag[D_WHEEL + 2 * i + 1], t)
+    _up(peaks, PK_GROUND_FY, diag[D_GROUND_FY], t)
+    _up(peaks, PK_TENSION_MAX, diag[D_MAX_TENSION], t)
+    _down(peaks, PK_TENSION_MIN, diag[D_MIN_TENSION], t)
+    _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t)
+    _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t)
+    _down(peaks, PK_VX_MIN, vx, t)
+    _up(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
+    _up(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
+    if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:
+        peaks[PK_FIRST_CORNER, 0] = 1.0
+        peaks[PK_FIRST_CORNER, 1] = t
+    if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
+        peaks[PK_FIRST_COMPRESSION, 0] = 1.0
+        peaks[PK_FIRST_COMPRESSION, 1] = t
+
+
+@njit(cache=True)
+def hermite_second_order(y0, f0, y1, f1, h, theta, nq, out):
+    """State at t0 + theta h from (q, qd, qdd) at both ends of a step of a second-order
+    system stored as y = (q, qd, extra): quintic Hermite for q, its derivative for qd,
+    cubic Hermite for the extra first-order components."""
+    t = theta
+    t2 = t * t
+    t3 = t2 * t
+    t4 = t3 * t
+    t5 = t4 * t
+    h00 = 1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5
+    h10 = t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5
+    h20 = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5
+    h01 = 10.0 * t3 - 15.0 * t4 + 6.0 * t5
+    h11 = -4.0 * t3 + 7.0 * t4 - 3.0 * t5
+    h21 = 0.5 * t3 - t4 + 0.5 * t5
+    d00 = (-30.0 * t2 + 60.0 * t3 - 30.0 * t4) / h
+    d10 = 1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4
+    d20 = h * (t - 4.5 * t2 + 6.0 * t3 - 2.5 * t4)
+    d11 = -12.0 * t2 + 28.0 * t3 - 15.0 * t4
+    d21 = h * (1.5 * t2 - 4.0 * t3 + 2.5 * t4)
+    for k in range(nq):
+        q0 = y0[k]
+        v0 = y0[nq + k]
+        a0 = f0[nq + k]
+        q1 = y1[k]
+        v1 = y1[nq + k]
+        a1 = f1[nq + k]
+        out[k] = h00 * q0 + h * h10 * v0 + h * h * h20 * a0 + h01 * q1 + h * h11 * v1 + h * h * h21 * a1
+        out[nq + k] = d00 * q0 + d10 * v0 + d20 * a0 - d00 * q1 + d11 * v1 + d21 * a1
+    c00 = 2.0 * t3 - 3.0 * t2 + 1.0
+    c10 = t3 - 2.0 * t2 + t
+    c01 = -2.0 * t3 + 3.0 * t2
+    c11 = t3 - t2
+    for k in range(2 * nq, y0.shape[0]):
+        out[k] = c00 * y0[k] + h * c10 * f0[k] + c01 * y1[k] + h * c11 * f1[k]

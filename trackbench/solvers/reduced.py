@@ -1,0 +1,148 @@
+"""Reduced-coordinate solver: an embedded explicit Runge-Kutta pair (tableau.py) with
+adaptive step size, the whole time loop compiled. Returns output samples on a regular
+grid (Hermite interpolation between accepted steps) and peaks over every step."""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, \
+    S_STATUS, S_STEPS, S_T_FINAL, Q_X
+from ..model.reduced import reduced_rhs
+from ..results import MAX_STEPS, NAN, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
+
+SAFETY = 0.9
+FAC_MIN = 0.2
+FAC_MAX = 10.0
+
+
+@njit(cache=True)
+def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n):
+    """RMS norm of the embedded error estimate over the first n components
+    (Hairer's DOP853 combination when e3 is given)."""
+    s5 = 0.0
+    s3 = 0.0
+    use3 = e3[0] != 0.0
+    for k in range(n):
+        sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
+        er = 0.0
+        er3 = 0.0
+        for j in range(K.shape[0]):
+            er += e[j] * K[j, k]
+            if use3:
+                er3 += e3[j] * K[j, k]
+        s5 += (er / sc) ** 2
+        s3 += (er3 / sc) ** 2
+    if use3:
+        den = s5 + 0.01 * s3
+        if den <= 0.0:
+            return 0.0
+        return abs(h) * s5 / math.sqrt(den * n)
+    return abs(h) * math.sqrt(s5 / n)
+
+
+@njit(cache=True)
+def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_min, max_steps,
+              par, arms, ends, seg, corners, nbr, ref, work, out_y, out_d, peaks, stats):
+    ny = y0.shape[0]
+    nq = (ny - 1) // 2
+    s = b.shape[0]
+    K = np.zeros((s + 1, ny))
+    y = y0.copy()
+    y_new = np.empty(ny)
+    ys = np.empty(ny)
+    fs = np.empty(ny)
+    diag = np.empty(out_d.shape[1])
+    n_rhs = 0
+    reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, K[0], diag)
+    n_rhs += 1
+    e_ref = energy_balance(diag)
+    r_ref = energy_residual(diag, y[ny - 1])
+    stats[S_E0] = e_ref - diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
+    init_peaks(peaks)
+    update_peaks(peaks, 0.0, diag, y[nq + Q_X], y[ny - 1], e_ref, r_ref)
+    out_y[0, :] = y
+    out_d[0, :] = diag
+    n_out = 1
+    n_out_max = out_y.shape[0]
+    status = SUCCESSFUL
+    if diag[D_STATUS] != 0.0:
+        status = int(diag[D_STATUS])
+    t = 0.0
+    h = min(h0, h_max)
+    steps = 0
+    rejected = 0
+    h_lo = np.inf
+    h_hi = 0.0
+    fac_max = FAC_MAX
+    while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
+        if steps + rejected >= max_steps:
+            status = MAX_STEPS
+            break
+        if h < h_min:
+            status = STEP_SIZE_UNDERFLOW
+            break
+        if t + h > t_end:
+            h = t_end - t
+        for i in range(1, s):
+            for k in range(ny):
+                acc = 0.0
+                for j in range(i):
+                    acc += A[i, j] * K[j, k]
+                ys[k] = y[k] + h * acc
+            reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, K[i], diag)
+        for k in range(ny):
+            acc = 0.0
+            for j in range(s):
+                acc += b[j] * K[j, k]
+            y_new[k] = y[k] + h * acc
+        reduced_rhs(y_new, par, arms, ends, seg, corners, nbr, ref, work, K[s], diag)
+        n_rhs += s
+        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, ny - 1)
+        if not (err <= 1.0):  # also catches NaN
+            rejected += 1
+            if err == err and err > 0.0:
+                h *= max(FAC_MIN, SAFETY * err ** expo)
+            else:
+                h *= FAC_MIN
+            fac_max = 1.0
+            continue
+        # accepted
+        t_new = t + h
+        steps += 1
+        h_lo = min(h_lo, h)
+        h_hi = max(h_hi, h)
+        for k in range(ny):
+            if not math.isfinite(y_new[k]):
+                status = NAN
+        if diag[D_STATUS] != 0.0:
+            status = int(diag[D_STATUS])
+        update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[ny - 1], e_ref, r_ref)
+        # output samples in (t, t_new]
+        while n_out < n_out_max and n_out * dt_out <= t_new * (1.0 + 1e-12):
+            t_o = n_out * dt_out
+            theta = min(1.0, (t_o - t) / h)
+            hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
+            out_y[n_out, :] = ys
+            reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, fs, out_d[n_out])
+            n_rhs += 1
+            n_out += 1
+        t = t_new
+        y[:] = y_new
+        K[0, :] = K[s]
+        if err == 0.0:
+            fac = fac_max
+        else:
+            fac = min(fac_max, SAFETY * err ** expo)
+        h = min(h * fac, h_max)
+        fac_max = FAC_MAX
+    stats[S_STATUS] = status
+    stats[S_T_FINAL] = t
+    stats[S_STEPS] = steps
+    stats[S_REJECTED] = rejected
+    stats[S_RHS] = n_rhs
+    stats[S_N_OUT] = n_out
+    stats[S_H_MIN] = h_lo
+    stats[S_H_MAX] = h_hi
