@@ -1,0 +1,17 @@
+"""Shared runs: each is simulated once per test session and reused (numba JIT cached)."""
+
+import pytest
+
+import trackbench as tb
+
+
+@pytest.fixture(scope="session")
+def paper_run():
+    """paper_step, 0.5 s, default settings (reduced solver)."""
+    return tb.simulate(tb.Scenario.paper())
+
+
+@pytest.fixture(scope="session")
+def paper_run_short():
+    """paper_step to 0.25 s: the part of the run that is reproducible to 1e-4."""
+    return tb.simulate(tb.Scenario.paper(duration=0.25))

@@ -1,0 +1,68 @@
+"""`trackbench run`: one scenario from the command line, its file and its summary."""
+
+import tomllib
+from pathlib import Path
+
+from .output import summary_numbers, write_netcdf
+from .scenario import RULES, Scenario, ScenarioError, flatten, paper_step
+
+
+def parse_assignment(text):
+    """'terrain.height=0.15' -> ('terrain.height', 0.15); values are read as TOML,
+    bare words as text."""
+    if "=" not in text:
+        raise ScenarioError(f"--set {text!r}: expected NAME=VALUE, e.g. --set speed=15")
+    key, raw = (s.strip() for s in text.split("=", 1))
+    try:
+        value = tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw
+    return key, value
+
+
+def scenario_from_sets(sets, duration=None):
+    overrides = dict(parse_assignment(s) for s in sets)
+    if duration is not None:
+        overrides["duration"] = duration
+    return Scenario.from_dict(overrides)
+
+
+def format_summary(ds, path=None):
+    s = summary_numbers(ds)
+    lines = [f"trackbench run '{ds.attrs['title'].split(': ', 1)[-1]}': {ds.attrs['status']}"
+             + ("" if ds.attrs["status"] == "completed" else f" at t = {ds.attrs['t_final']:.6g} s: {ds.attrs['status_message']}")]
+    lines.append("  peak vertical wheel-track force (kN) and time (s):")
+    for w, f, t in zip(ds.wheel.values, ds.peak_wheel_force_y.values, ds.peak_wheel_force_y_time.values):
+        lines.append(f"    wheel {int(w)}: {f / 1e3:10.1f}  at {t:.4f}")
+    lines += [
+        f"  peak total ground force   {s['peak_ground_force_y_kN']:10.1f} kN at {float(ds.peak_ground_force_y_time):.4f} s",
+        f"  peak link tension         {s['peak_link_tension_kN']:10.1f} kN",
+        f"  chassis vertical accel    {s['min_chassis_ay']:+.2f} .. {s['peak_chassis_ay']:+.2f} m/s^2",
+        f"  min chassis speed         {s['min_chassis_vx']:.4f} m/s",
+        f"  first obstacle contact    {s['first_contact_time']:.5f} s; first link compression {s['first_compression_time']:.4f} s",
+        f"  energy balance error      {100 * s['max_energy_balance_error']:.4f} % (paper: < 0.06 %); work residual {s['max_energy_residual']:.2e}",
+        f"  steps {ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected), wall time {ds.attrs['wall_time']:.3f} s",
+        "  note: peaks after the first compression are sensitive to tiny changes (chaotic motion); compare them as ranges.",
+    ]
+    if path:
+        lines.append(f"  written: {path}")
+    return "\n".join(lines)
+
+
+def run_one(sets, duration, out, name):
+    from .simulate import simulate
+    sc = scenario_from_sets(sets, duration)
+    sc = sc.with_overrides({"name": name})
+    ds = simulate(sc)
+    path = write_netcdf(ds, Path(out) / f"{name}.nc")
+    return format_summary(ds, path)
+
+
+def parameter_table():
+    base = flatten({k: v for k, v in paper_step().items() if k != "terrain"})
+    rows = [f"{'name':32s} {'paper value':>16s}  allowed"]
+    for k, rule in RULES.items():
+        rows.append(f"{k:32s} {str(base.get(k, '')):>16s}  {rule[3]}")
+    rows.append("terrain.kind                     step              flat, step, ramp, block, bump, points, sequence")
+    rows.append("terrain.height / length / position / first_contact_time / gap / points / obstacles: see README")
+    return "\n".join(rows)
