@@ -33,8 +33,8 @@ def paper_step():
         "duration": 0.5,
         "gravity": GRAVITY,
         "solver": "reduced",
-        "method": "dop853",
-        "tolerance": 1e-9,
+        "method": "dopri5",
+        "tolerance": 1e-8,
         "output_interval": 1e-4,
         "max_steps": 2_000_000,
         "perturbation": 0.0,     # m: seeded nudge of the free pins (study replicates)

@@ -116,9 +116,9 @@ class _Problem:
         return q
 
     def loads(self, q):
-        apos, avel, fpin, fwheel, wc, wv, lk, _ = self.work
+        apos, avel, fpin, fwheel, wc, wv, lk, arm = self.work
         zero = np.zeros(self.nq)
-        positions(q, zero, self.par, self.arms, self.ends, apos, avel, wc, wv)
+        positions(q, zero, self.par, self.arms, self.ends, apos, avel, wc, wv, arm)
         track_loads(apos, avel, wc, wv, self.par, self.seg, self.corners, self.nbr, self.ref,
                     lk, fpin, fwheel, self.diag, L.diag_tension(self.nw))
         return apos, fpin, fwheel, wc

@@ -80,7 +80,8 @@ def n_diag(n_wheels, n_links):
     return diag_tension(n_wheels) + n_links
 
 
-# --- peaks over every accepted step, ``peaks`` (rows: value, time) -----------------
+# --- peaks over every accepted step, ``peaks`` (columns: value, time, then the last
+#     two samples f, t, f, t used to refine a local extremum by a parabola) ----------
 PK_GROUND_FY = 0         # max total vertical ground force (N)
 PK_TENSION_MAX = 1       # max link tension (N)
 PK_TENSION_MIN = 2       # min link tension (N; negative = compression)

@@ -23,12 +23,13 @@ def allocate_work(n_wheels, n_links):
     n_pins = n_links + 1
     return (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
-            np.zeros((n_links, 3)), np.zeros((n_wheels, 4)))
+            np.zeros((n_links, 3)), np.zeros((n_wheels, 6)))
 
 
 @njit(cache=True)
-def positions(q, qd, par, arms, ends, apos, avel, wc, wv):
-    """Pin and wheel-centre positions and velocities from the reduced state."""
+def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
+    """Pin and wheel-centre positions and velocities from the reduced state; keeps
+    cos and sin of each arm's absolute angle in arm[:, 4:6] for the caller."""
     nw = arms.shape[0]
     n_pins = apos.shape[0]
     off = Q_ARM + nw
@@ -40,6 +41,8 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv):
         beta = q[Q_PITCH] + q[Q_ARM + i]
         cb = math.cos(beta)
         sb = math.sin(beta)
+        arm[i, 4] = cb
+        arm[i, 5] = sb
         rx = c * arms[i, 0] - s * arms[i, 1] + la * cb
         ry = s * arms[i, 0] + c * arms[i, 1] + la * sb
         wc[i, 0] = q[Q_X] + rx
@@ -74,7 +77,7 @@ def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     nq = (y.shape[0] - 1) // 2
     q = y[:nq]
     qd = y[nq:2 * nq]
-    positions(q, qd, par, arms, ends, apos, avel, wc, wv)
+    positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm)
     track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel,
                 diag, D_WHEEL + 2 * nw)
 
@@ -115,9 +118,8 @@ def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     bt_ = arm[:, 2]
     qa_ = arm[:, 3]  # generalised force on phi_i
     for i in range(nw):
-        beta = th + q[Q_ARM + i]
-        cb = math.cos(beta)
-        sb = math.sin(beta)
+        cb = arm[i, 4]
+        sb = arm[i, 5]
         px = c * arms[i, 0] - s * arms[i, 1]
         py = s * arms[i, 0] + c * arms[i, 1]
         rx = px + la * cb

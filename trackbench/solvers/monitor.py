@@ -29,6 +29,7 @@ def energy_residual(diag, work):
 def init_peaks(peaks):
     peaks[:, 0] = -np.inf
     peaks[:, 1] = np.nan
+    peaks[:, 2:] = np.nan  # history of the last two samples: f, t, f, t
     peaks[PK_TENSION_MIN, 0] = np.inf
     peaks[PK_AY_MIN, 0] = np.inf
     peaks[PK_VX_MIN, 0] = np.inf
@@ -39,17 +40,44 @@ def init_peaks(peaks):
 
 
 @njit(cache=True, inline="always")
-def _up(peaks, k, v, t):
+def _max(peaks, k, v, t):
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
 
 
 @njit(cache=True, inline="always")
-def _down(peaks, k, v, t):
-    if v < peaks[k, 0]:
+def _up(peaks, k, v, t):
+    """Running maximum of a quantity sampled at every accepted step. A local maximum at
+    the previous step is refined by the parabola through the last three samples, so a
+    smooth peak is found to O(h^3) rather than to the step spacing (O(h^2))."""
+    if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
+    f0, t0, f1, t1 = peaks[k, 2], peaks[k, 3], peaks[k, 4], peaks[k, 5]
+    if f1 >= f0 and f1 >= v and t1 > t0 and t > t1:
+        d01 = (f1 - f0) / (t1 - t0)
+        d12 = (v - f1) / (t - t1)
+        a = (d12 - d01) / (t - t0)
+        if a < 0.0:
+            ts = 0.5 * (t0 + t1) - d01 / (2.0 * a)
+            if t0 <= ts <= t:
+                fs = f0 + d01 * (ts - t0) + a * (ts - t0) * (ts - t1)
+                if fs > peaks[k, 0]:
+                    peaks[k, 0] = fs
+                    peaks[k, 1] = ts
+    peaks[k, 2] = f1
+    peaks[k, 3] = t1
+    peaks[k, 4] = v
+    peaks[k, 5] = t
+
+
+@njit(cache=True, inline="always")
+def _down(peaks, k, v, t):
+    """Running minimum, refined like _up (the history holds -v)."""
+    peaks[k, 0] = -peaks[k, 0]
+    _up(peaks, k, -v, t)
+    peaks[k, 0] = -peaks[k, 0]
 
 
 @njit(cache=True)
@@ -64,8 +92,8 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
     _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t)
     _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t)
     _down(peaks, PK_VX_MIN, vx, t)
-    _up(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
-    _up(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
+    _max(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
+    _max(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
     if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:
         peaks[PK_FIRST_CORNER, 0] = 1.0
         peaks[PK_FIRST_CORNER, 1] = t
