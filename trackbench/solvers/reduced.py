@@ -19,22 +19,38 @@ FAC_MAX = 10.0
 
 
 @njit(cache=True)
-def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n):
+def _combine(y, h, w, K, m, out):
+    """out = y + h * sum_j<m w_j K_j (zero weights skipped; inner loop over the state)."""
+    out[:] = y
+    for j in range(m):
+        c = h * w[j]
+        if c != 0.0:
+            Kj = K[j]
+            for k in range(out.shape[0]):
+                out[k] += c * Kj[k]
+
+
+@njit(cache=True)
+def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
+    use3 = e3[0] != 0.0
+    er5[:] = 0.0
+    er3[:] = 0.0
+    for j in range(K.shape[0]):
+        Kj = K[j]
+        if e[j] != 0.0:
+            for k in range(n):
+                er5[k] += e[j] * Kj[k]
+        if use3 and e3[j] != 0.0:
+            for k in range(n):
+                er3[k] += e3[j] * Kj[k]
     s5 = 0.0
     s3 = 0.0
-    use3 = e3[0] != 0.0
     for k in range(n):
         sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
-        er = 0.0
-        er3 = 0.0
-        for j in range(K.shape[0]):
-            er += e[j] * K[j, k]
-            if use3:
-                er3 += e3[j] * K[j, k]
-        s5 += (er / sc) ** 2
-        s3 += (er3 / sc) ** 2
+        s5 += (er5[k] / sc) ** 2
+        s3 += (er3[k] / sc) ** 2
     if use3:
         den = s5 + 0.01 * s3
         if den <= 0.0:
@@ -54,6 +70,8 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     y_new = np.empty(ny)
     ys = np.empty(ny)
     fs = np.empty(ny)
+    er5 = np.empty(ny)
+    er3 = np.empty(ny)
     diag = np.empty(out_d.shape[1])
     n_rhs = 0
     reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, K[0], diag)
@@ -87,20 +105,12 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
         if t + h > t_end:
             h = t_end - t
         for i in range(1, s):
-            for k in range(ny):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, k]
-                ys[k] = y[k] + h * acc
+            _combine(y, h, A[i], K, i, ys)
             reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, K[i], diag)
-        for k in range(ny):
-            acc = 0.0
-            for j in range(s):
-                acc += b[j] * K[j, k]
-            y_new[k] = y[k] + h * acc
+        _combine(y, h, b, K, s, y_new)
         reduced_rhs(y_new, par, arms, ends, seg, corners, nbr, ref, work, K[s], diag)
         n_rhs += s
-        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, ny - 1)
+        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, ny - 1, er5, er3)
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
             if err == err and err > 0.0:
