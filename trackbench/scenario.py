@@ -43,7 +43,7 @@ def paper_step():
         "track": paper_track(),
         "terrain": {"kind": "step", "height": 0.1, "first_contact_time": 0.0568},
         "lee": {"accel_order": 10, "eps_iterations": 10, "position_tol": 1e-9,
-                "max_iterations": 500},
+                "max_iterations": 500, "matrix_update_angle": 1e-3},
         "record": {"enabled": True, "every": 1},
     }
 
@@ -88,6 +88,7 @@ RULES = {
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
     "lee.max_iterations": (int, 1, 100000, "an integer >= 1"),
+    "lee.matrix_update_angle": (float, 0.0, 1.0, "a number in [0, 1] rad (0: rebuild A_n after every step)"),
     "record.enabled": (bool, None, None, "true or false"),
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }

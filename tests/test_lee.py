@@ -1,0 +1,261 @@
+"""The "lee" solver (issue 3): absolute coordinates, Lee's accelerated multiplier
+iteration, Dormand-Prince RKN6(4) steps; cross-validated against the reduced solver.
+
+Runs are shared through module fixtures; every simulation is as short as its test
+needs. Targets that the current code does not meet are marked xfail(strict=True) with
+their measured figures, so they stay visible (and turn into failures if they start
+passing and the mark is stale)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import trackbench as tb
+from trackbench.output import summary_numbers
+from trackbench.simulate import equilibrium
+from trackbench.solvers.lee_iter import accel_matrix
+from trackbench.solvers.rkn_tableau import RKN64, NystromPair
+
+EARLY = 0.25          # s: the reproducible part of paper_step (spec)
+RED_TOLS = (1e-8, 1e-9, 1e-10, 1e-11)
+
+
+def lee(**kw):
+    return tb.simulate(tb.Scenario.paper(solver="lee", **kw))
+
+
+@pytest.fixture(scope="module")
+def lee_run():
+    """paper_step, 0.5 s, default settings, n = 10."""
+    return lee()
+
+
+@pytest.fixture(scope="module")
+def lee_plain():
+    """The same run with the plain iteration (n = 1)."""
+    return lee(**{"lee.accel_order": 1})
+
+
+@pytest.fixture(scope="module")
+def reduced_runs(paper_run):
+    """Reduced solver, 0.5 s, at tolerances 1e-8 .. 1e-11 (the default one shared)."""
+    out = {}
+    for tol in RED_TOLS:
+        if tol == paper_run.attrs["tolerance"]:
+            out[tol] = paper_run
+        else:
+            out[tol] = tb.simulate(tb.Scenario.paper(tolerance=tol))
+    return out
+
+
+# --------------------------------------------------------------------------- tables
+def test_rkn_table_is_validated_and_sixth_order():
+    A, b, bp, c, eb, ebp, expo = RKN64.arrays()
+    assert RKN64.stages == 6 and expo == pytest.approx(-0.2)
+    with pytest.raises(ValueError):
+        NystromPair("bad", 6, 4, RKN64.c, RKN64.a, tuple(x * 1.001 for x in RKN64.b), RKN64.bp, RKN64.eb,
+                    RKN64.ebp)
+
+    # y'' = -y, fixed steps: global error falls like h^6
+    def solve(n):
+        h = 2.0 / n
+        y, yd = 1.0, 0.0
+        for _ in range(n):
+            k = np.zeros(6)
+            for i in range(6):
+                k[i] = -(y + c[i] * h * yd + h * h * np.dot(A[i, :i], k[:i]))
+            y, yd = y + h * yd + h * h * np.dot(b, k), yd + h * np.dot(bp, k)
+        return abs(y - math.cos(2.0)) + abs(yd + math.sin(2.0))
+
+    ratio = solve(20) / solve(40)
+    assert 2 ** 5.5 < ratio < 2 ** 7
+
+
+def _paper_alpha_an(C, n, eps1):
+    """(A1)-(A6) literally, without the rescaling (fine for small n)."""
+    m = C.shape[0]
+    C1 = C / np.abs(C).sum(axis=1).max()
+    Cn, An, eps, w = C1.copy(), np.eye(m), eps1, 1.0
+    for _ in range(2, n + 1):
+        bn = eps + w
+        T = bn * np.eye(m) - Cn
+        An, Cn = T @ An, Cn @ T
+        eps, w = eps * w, bn * bn / 4.0
+    assert np.allclose(Cn, C1 @ An, rtol=1e-10, atol=1e-300)   # (A6)
+    return 2.0 / (w + eps) * An                                 # alpha_n A_n, Eq. (16)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5])
+def test_accel_matrix_is_the_papers(n):
+    rng = np.random.default_rng(3)
+    X = rng.normal(size=(10, 10))
+    G = X @ X.T + 0.5 * np.eye(10)
+    An, Cn, T, tmp = (np.zeros((10, 10)) for _ in range(4))
+    alpha, gn = accel_matrix(G, n, 0.05, An, Cn, T, tmp)
+    assert gn == pytest.approx(np.abs(G).sum(axis=1).max())
+    np.testing.assert_allclose(alpha * An, _paper_alpha_an(G, n, 0.05), rtol=1e-9)
+
+
+# ------------------------------------------------------------ cross-validation, early
+def _early_diff(a, b):
+    n = int(round(EARLY / float(a.time[1] - a.time[0]))) + 1
+    return {v: float(np.abs(a[v].values[:n] - b[v].values[:n]).max()) for v in ("chassis_y", "chassis_pitch")}
+
+
+@pytest.fixture(scope="module")
+def lee_short():
+    return lee(duration=EARLY)
+
+
+def test_early_events_agree(lee_short, paper_run_short):
+    """First contact and the peak vertical forces of wheels 1 and 2 within 0.1 %."""
+    a, r = lee_short, paper_run_short
+    assert a.attrs["status"] == "completed"
+    assert float(a.first_contact_time) == pytest.approx(float(r.first_contact_time), rel=1e-3)
+    np.testing.assert_allclose(a.peak_wheel_force_y.values[:2], r.peak_wheel_force_y.values[:2], rtol=1e-3)
+
+
+def test_early_trajectory_agrees_at_tight_tolerance():
+    """At integration tolerance 1e-11 for both solvers: chassis y and pitch within
+    1e-6 m / 1e-6 rad at every output time up to 0.25 s."""
+    a = lee(duration=EARLY, tolerance=1e-11)
+    r = tb.simulate(tb.Scenario.paper(duration=EARLY, tolerance=1e-11))
+    d = _early_diff(a, r)
+    print("lee vs reduced at tol 1e-11:", d)
+    assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
+
+
+@pytest.mark.xfail(strict=True, reason="at the default tolerance (1e-8) the solvers differ by 7.4e-6 m / "
+                   "1.6e-5 rad by t = 0.25 s; the reduced solver alone moves by 8.5e-6 m / 1.8e-5 rad between "
+                   "tolerance 1e-8 and 1e-11 there (chaotic growth after 0.1 s), while lee at 1e-8 is 2.2e-6 m / "
+                   "2.0e-6 rad from reduced at 1e-11: the 1e-6 bar is below the reference's own error at this "
+                   "tolerance; at 1e-11 (test above) and up to 0.15 s (test below) the bar holds")
+def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short):
+    d = _early_diff(lee_short, paper_run_short)
+    print("lee vs reduced at the default tolerance:", d)
+    assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
+
+
+def test_trajectory_agrees_before_chaos_at_default_tolerance(lee_short, paper_run_short):
+    n = int(round(0.15 / 1e-4)) + 1
+    for v in ("chassis_y", "chassis_pitch"):
+        assert np.abs(lee_short[v].values[:n] - paper_run_short[v].values[:n]).max() <= 1e-6
+
+
+# ----------------------------------------------------------- cross-validation, late
+def _out_of_range(lee_run, reduced_runs):
+    red = [summary_numbers(ds) for ds in reduced_runs.values()]
+    mine = summary_numbers(lee_run)
+    bad = {}
+    for k, v in mine.items():
+        if k in ("status", "steps", "wall_time"):
+            continue
+        vals = [r[k] for r in red]
+        lo, hi = min(vals), max(vals)
+        w = hi - lo
+        if not (lo - w / 2 <= v <= hi + w / 2):
+            bad[k] = (v, lo - w / 2, hi + w / 2)
+    return bad
+
+
+# the quantities the spec names as chaotic-sensitive (late wheel 3-5 peaks, acceleration
+# extremes after 0.25 s, peak link tension): compared only in the non-strict xfail below
+SENSITIVE = ("peak_wheel3_force_y_kN", "peak_wheel4_force_y_kN", "peak_wheel5_force_y_kN", "peak_chassis_ay",
+             "min_chassis_ay", "peak_link_tension_kN")
+
+
+def test_late_summary_within_reduced_spread(lee_run, reduced_runs):
+    """Every summary quantity but the spec's sensitive ones lies in the reduced solver's
+    range over tolerances 1e-8..1e-11, widened by half its width on each side."""
+    bad = _out_of_range(lee_run, reduced_runs)
+    print("out of the widened reduced range (value, low, high):", bad)
+    assert not {k: v for k, v in bad.items() if k not in SENSITIVE}
+
+
+@pytest.mark.xfail(strict=False, reason="chaotic late quantities: at the default settings the peak link tension "
+                   "(lee 323.7 kN vs widened reduced range [338.1, 342.5] kN; lee gives 372 kN at tol 1e-9, 347 kN "
+                   "at 1e-10) and the peak chassis ay (lee 56.0 vs [25.9, 46.6] m/s^2; 38.4 at 1e-9) miss it; "
+                   "which ones miss changes with any perturbation (spec: 10-60 % between correct runs)")
+def test_late_summary_all_within_reduced_spread(lee_run, reduced_runs):
+    assert not _out_of_range(lee_run, reduced_runs)
+
+
+def test_energy(lee_run, paper_run):
+    assert lee_run.attrs["status"] == "completed"
+    # integration error: the work-based residual stays tiny for the whole run
+    assert float(lee_run.max_energy_residual) < 1e-6
+    assert np.abs(lee_run.energy_residual.values).max() < 1e-6
+    # the paper's 0.06 % bar: lee over the whole run (every accepted step), both solvers
+    # over the reproducible part
+    assert float(lee_run.max_energy_balance_error) < 6e-4
+    for ds in (lee_run, paper_run):
+        assert np.abs(ds.energy_balance_error.sel(time=slice(0, EARLY)).values).max() < 6e-4
+
+
+@pytest.mark.xfail(strict=False, reason="the reduced solver's whole-run max energy-balance deviation is 0.19 % "
+                   "at the default settings (lee: 0.004 %), from the contact model's energy jumps after 0.25 s "
+                   "(spec); its work-based residual is 2e-8")
+def test_energy_bar_whole_run_reduced(paper_run):
+    assert float(paper_run.max_energy_balance_error) < 6e-4
+
+
+# ---------------------------------------------------------------- the iteration itself
+def test_constraint_errors_within_tolerance(lee_run):
+    for lvl in ("position", "velocity", "acceleration"):
+        assert float(lee_run[f"lee_max_error_ratio_{lvl}"]) <= 1.0
+        assert np.nanmax(lee_run[f"lee_error_ratio_{lvl}"].values) <= 1.0
+    tol = tb.Scenario.paper()["lee.position_tol"]
+    assert np.nanmax(lee_run.lee_error_position.values) <= tol
+    assert int(lee_run.lee_rejected_constraint) == 0
+
+
+def test_accelerated_iteration_needs_fewer_iterations(lee_run, lee_plain):
+    levels = ("position", "velocity", "acceleration")
+    acc = {lvl: int(lee_run[f"lee_total_iterations_{lvl}"]) for lvl in levels}
+    plain = {lvl: int(lee_plain[f"lee_total_iterations_{lvl}"]) for lvl in levels}
+    print("iterations n = 10:", acc, "steps", lee_run.attrs["steps"])
+    print("iterations n = 1: ", plain, "steps", lee_plain.attrs["steps"])
+    assert lee_plain.attrs["status"] == "completed"
+    for lvl in levels:
+        assert acc[lvl] < 0.5 * plain[lvl]
+    assert sum(acc.values()) < 0.25 * sum(plain.values())
+    assert float(lee_plain.max_energy_residual) < 1e-6
+
+
+def test_joint_forces_and_extra_outputs(lee_run):
+    for name in ("joint_force_x", "joint_force_y"):
+        v = lee_run[name]
+        assert v.dims == ("time", "wheel") and v.attrs["units"] == "N" and v.attrs["long_name"]
+    for name in ("lee_iterations_position", "lee_error_velocity", "lee_rejected_steps", "lee_step_size"):
+        assert lee_run[name].dims == ("time",) and "units" in lee_run[name].attrs
+    assert int(lee_run.lee_steps.sum()) == lee_run.attrs["steps"]
+    # at t = 0 (equilibrium) each arm is at rest: pivot force + wheel force + weight = 0
+    g = tb.Scenario.paper()["gravity"]
+    m = tb.Scenario.paper()["vehicle.arm_mass"]
+    fy = lee_run.joint_force_y.values[0] + lee_run.wheel_force_y.values[0] - m * g
+    fx = lee_run.joint_force_x.values[0] + lee_run.wheel_force_x.values[0]
+    assert np.abs(fy).max() < 1e-3 and np.abs(fx).max() < 1e-3
+
+
+# ------------------------------------------------------------------- flat ground
+def test_flat_ground_rigid_translation():
+    sc = tb.Scenario.paper(terrain={"kind": "flat"}, duration=0.5, solver="lee")
+    ds = tb.simulate(sc)
+    eq = equilibrium(sc)
+    q0, pins0, wc0 = eq.q, eq.info["pins"], eq.info["wheel_centres"]
+    t = ds.time.values
+    assert ds.attrs["status"] == "completed" and t[-1] == pytest.approx(0.5)
+    dev = {
+        "chassis_x": np.abs(ds.chassis_x.values - 10.0 * t),
+        "chassis_y": np.abs(ds.chassis_y.values - q0[1]),
+        "chassis_pitch": np.abs(ds.chassis_pitch.values - q0[2]),
+        "arm_angle": np.abs(ds.arm_angle.values - q0[3:8]),
+        "wheel_x": np.abs(ds.wheel_x.values - wc0[:, 0] - 10.0 * t[:, None]),
+        "wheel_y": np.abs(ds.wheel_y.values - wc0[:, 1]),
+        "pin_x": np.abs(ds.pin_x.values - pins0[:, 0] - 10.0 * t[:, None]),
+        "pin_y": np.abs(ds.pin_y.values - pins0[:, 1]),
+    }
+    worst = {k: float(v.max()) for k, v in dev.items()}
+    print("flat translation, max deviation:", worst)
+    assert max(worst.values()) < 1e-7

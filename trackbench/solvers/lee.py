@@ -1,0 +1,87 @@
+"""Python side of the "lee" solver (paper sections 3-4): absolute coordinates, Lagrange
+multipliers by Lee's accelerated iteration, the Dormand-Prince RKN6(4) pair. Takes and
+returns the reduced layout so every output means the same as for the reduced solver;
+solver-specific figures go to RunResult.extra (results_schema.md, lee section)."""
+
+import numpy as np
+import xarray as xr
+
+from ..model.absolute import inverse_mass
+from .base import allocate_outputs, trimmed
+from .lee_loop import (L_BUILDS, L_EPS1, L_IT_ACC, L_IT_OUT, L_IT_POS, L_IT_VEL, L_PASSES, L_RATIO_ACC, L_RATIO_POS,
+                       L_RATIO_VEL, L_REJ_CONSTRAINT, L_REJ_ERROR, N_L, N_X, X_ERR_ACC, X_ERR_POS, X_ERR_VEL,
+                       X_H, X_IT_ACC, X_IT_POS, X_IT_VEL, X_RATIO_ACC, X_RATIO_POS, X_RATIO_VEL, X_REJECTED,
+                       X_STEPS, integrate_lee)
+from .rkn_tableau import RKN64
+
+H0 = 1e-5        # s: first trial step
+H_MIN = 1e-13    # s: below this the run stops with STEP_SIZE_UNDERFLOW
+
+_PER_SAMPLE = [  # (name, column, units, long_name)
+    ("lee_steps", X_STEPS, "1", "accepted steps since the previous output sample"),
+    ("lee_rejected_steps", X_REJECTED, "1", "rejected step attempts (error test or position iteration) "
+                                            "since the previous output sample"),
+    ("lee_iterations_position", X_IT_POS, "1", "lambda iterations, position level Eq. (12), summed over "
+                                               "the accepted steps since the previous sample"),
+    ("lee_iterations_velocity", X_IT_VEL, "1", "lambda iterations, velocity level Eq. (13), summed likewise"),
+    ("lee_iterations_acceleration", X_IT_ACC, "1", "lambda iterations, acceleration level Eq. (14), "
+                                                   "summed likewise"),
+    ("lee_error_position", X_ERR_POS, "m", "max final position constraint error max|Phi| over those steps"),
+    ("lee_error_velocity", X_ERR_VEL, "m s-1", "max final velocity constraint error over those steps"),
+    ("lee_error_acceleration", X_ERR_ACC, "m s-2", "max final acceleration constraint error over those steps"),
+    ("lee_error_ratio_position", X_RATIO_POS, "1", "max position constraint error / its tolerance"),
+    ("lee_error_ratio_velocity", X_RATIO_VEL, "1", "max velocity constraint error / (position_tol / h)"),
+    ("lee_error_ratio_acceleration", X_RATIO_ACC, "1", "max acceleration constraint error / (position_tol / h^2)"),
+    ("lee_step_size", X_H, "s", "size of the last accepted step before the sample"),
+]
+
+
+def _v(dims, data, units, long_name):
+    return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name})
+
+
+def run(scenario, model, y0):
+    A, b, bp, c, eb, ebp, expo = RKN64.arrays()
+    out_y, out_d, peaks, stats = allocate_outputs(scenario, model, y0.size)
+    n_out = out_y.shape[0]
+    out_x = np.zeros((n_out, N_X))
+    out_lam = np.full((n_out, 2 * model.nw), np.nan)
+    lstats = np.zeros(N_L)
+    tol = scenario["tolerance"]
+    dt_out = scenario["output_interval"]
+    minv = inverse_mass(model.par, model.nw, model.n_links)
+    integrate_lee(y0, scenario["duration"], dt_out, A, b, bp, c, eb, ebp, expo, tol, tol,
+                  min(H0, dt_out), dt_out, H_MIN, scenario["max_steps"],
+                  scenario["lee.accel_order"], scenario["lee.eps_iterations"], scenario["lee.position_tol"],
+                  scenario["lee.max_iterations"], scenario["lee.matrix_update_angle"], minv,
+                  model.par, model.arms, model.ends, model.seg, model.corners, model.nbr, model.ref,
+                  model.work, out_y, out_d, out_x, out_lam, peaks, stats, lstats)
+    n = int(stats[5])  # S_N_OUT
+    T, W = ("time",), ("time", "wheel")
+    extra = {name: _v(T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
+    extra["joint_force_x"] = _v(W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
+                                "pivot (Lagrange multiplier lambda, acceleration level)")
+    extra["joint_force_y"] = _v(W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
+                                "pivot (Lagrange multiplier lambda, acceleration level)")
+    totals = [
+        ("lee_total_iterations_position", L_IT_POS, "1", "lambda iterations at the position level, whole run "
+                                                         "(rejected attempts included)"),
+        ("lee_total_iterations_velocity", L_IT_VEL, "1", "lambda iterations at the velocity level, whole run"),
+        ("lee_total_iterations_acceleration", L_IT_ACC, "1", "lambda iterations at the acceleration level, "
+                                                             "whole run (output samples excluded)"),
+        ("lee_total_iterations_output", L_IT_OUT, "1", "acceleration-level iterations at the output samples"),
+        ("lee_step_passes", L_PASSES, "1", "RKN passes over a step (one per position-level iteration + 1)"),
+        ("lee_rejected_error", L_REJ_ERROR, "1", "steps rejected by the integration error test"),
+        ("lee_rejected_constraint", L_REJ_CONSTRAINT, "1", "steps rejected because the position-level "
+                                                           "iteration did not converge (step halved)"),
+        ("lee_matrix_builds", L_BUILDS, "1", "constructions of A_n and alpha (A1-A6, Eq. 16)"),
+        ("lee_eps1", L_EPS1, "1", "eps-bar-1 of Eq. (20): estimated smallest eigenvalue of C_1"),
+        ("lee_max_error_ratio_position", L_RATIO_POS, "1", "max over accepted steps of position error / tolerance"),
+        ("lee_max_error_ratio_velocity", L_RATIO_VEL, "1", "max over accepted steps of velocity error / tolerance"),
+        ("lee_max_error_ratio_acceleration", L_RATIO_ACC, "1", "max over accepted steps of acceleration error "
+                                                               "/ tolerance"),
+    ]
+    for name, k, units, text in totals:
+        extra[name] = _v((), lstats[k], units, text)
+    extra["lee_accel_order"] = _v((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
+    return trimmed(scenario, out_y, out_d, peaks, stats, extra)
