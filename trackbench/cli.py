@@ -42,7 +42,130 @@ def params():
 
 # --- study commands (issue 4) -------------------------------------------------------
 
+def _load_study_or_fail(file: Path):
+    from .study import StudyError, load_study
+    try:
+        return load_study(file)
+    except StudyError as e:
+        _fail(str(e))
+
+
+@study_app.command("run")
+def study_run(
+    file: Path = typer.Argument(..., help="Study file (TOML), e.g. studies/speed_sweep.toml."),
+    workers: int = typer.Option(2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."),
+    executor: str = typer.Option("local", help="local (process pool) or dask (dask.distributed)."),
+    scheduler: Optional[str] = typer.Option(None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."),
+    force: bool = typer.Option(False, "--force", help="Rerun every run, also those already completed."),
+):
+    """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
+    from .study import StudyError, StudyLocked, run_study
+    from .study.runner import report
+    try:
+        outcome = run_study(file, workers=workers, executor=executor, scheduler=scheduler, force=force)
+    except (StudyError, ValueError) as e:
+        _fail(str(e))
+    except StudyLocked as e:
+        _fail(str(e), code=3)
+    except RuntimeError as e:  # e.g. the dask scheduler cannot be reached
+        _fail(str(e), code=1)
+    except KeyboardInterrupt:
+        _fail("interrupted: completed runs are kept; run the same command again to finish the study", code=130)
+    typer.echo(report(outcome))
+    if outcome.failed_total:
+        _fail(f"{outcome.failed_total} of {len(outcome.study.runs)} runs failed (reasons in the summary and "
+              "in runs/<run-id>/run.json)", code=1)
+
+
+@study_app.command("summary")
+def study_summary(file: Path = typer.Argument(..., help="Study file (TOML).")):
+    """Print the study's summary table (rebuilt from the runs' run.json; summary files rewritten)."""
+    from .study.summary import format_table, write_summary
+    study = _load_study_or_fail(file)
+    if not study.output.is_dir():
+        _fail(f"no results yet for study {study.name} (looked in {study.output}); run: trackbench study run {file}")
+    df, rep = write_summary(study)
+    typer.echo(format_table(df, rep, study.param_names))
+
+
+@study_app.command("status")
+def study_status(file: Path = typer.Argument(..., help="Study file (TOML).")):
+    """Show how many runs are done, failed and pending."""
+    from .study.runner import status_counts
+    study = _load_study_or_fail(file)
+    counts, df = status_counts(study)
+    typer.echo(f"study {study.name}: {len(study.runs)} runs: {counts['completed']} done, {counts['failed']} failed, "
+               f"{counts['pending']} pending ({study.output})")
+    for _, r in df[df.status == "failed"].iterrows():
+        typer.echo(f"  failed {r.run_id}: {r.status_message}")
+
+
 # --- replay commands (issue 5) ------------------------------------------------------
+
+@app.command()
+def view(
+    path: Path = typer.Argument(..., help="A run folder (recording.rrd inside), an .rrd or .nc file, or a study "
+                                          "(results folder or TOML) followed by RUN_ID."),
+    run_id: Optional[str] = typer.Argument(None, help="Run id within a study (a unique prefix is enough)."),
+):
+    """Open the rerun viewer on a run's recording (needs a display; otherwise says how to open it elsewhere)."""
+    from .replay.view import ViewError, open_viewer
+    try:
+        code = open_viewer(path, run_id)
+    except (ViewError, ValueError) as e:
+        _fail(str(e), 3)
+    raise typer.Exit(code)
+
+
+@app.command()
+def plot(
+    path: Path = typer.Argument(..., help="A run (.nc file or run folder) or a study (results folder or TOML)."),
+    out: Optional[Path] = typer.Option(None, "--out", "-o", help="Folder for the PNG files; default: "
+                                       "RUN_FOLDER/plots, NAME_plots beside a .nc file, STUDY/plots."),
+    times: str = typer.Option("0.1,0.35,0.45", help="Times (s) of the configuration figure, comma-separated."),
+):
+    """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
+    from .replay.plots import plot_run, plot_study
+    try:
+        tt = tuple(float(x) for x in times.split(",") if x.strip())
+    except ValueError:
+        _fail(f"--times {times!r}: expected numbers separated by commas, e.g. 0.1,0.35,0.45")
+    is_study = path.suffix == ".toml" or (path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir()))
+    if out is None:
+        out = (path.parent / (path.stem + "_plots")) if path.is_file() and path.suffix == ".nc" else None
+    try:
+        if is_study:
+            if out is None:
+                from .replay.view import study_output
+                out = (study_output(path) if path.suffix == ".toml" else path) / "plots"
+            paths = plot_study(path, out)
+        else:
+            paths = plot_run(path, out if out is not None else path / "plots", times=tt)
+    except (FileNotFoundError, ValueError, ImportError) as e:
+        _fail(str(e))
+    for p in paths:
+        typer.echo(f"written: {p}")
+
+
+@app.command()
+def record(
+    nc: Path = typer.Argument(..., help="A run's netCDF file (or a run folder holding timeseries.nc)."),
+    out: Optional[Path] = typer.Option(None, "--out", "-o", help="The .rrd file; default: beside the .nc "
+                                       "(recording.rrd in a run folder, NAME.rrd otherwise)."),
+    every: int = typer.Option(1, "--every", min=1, help="Log the side view at every k-th output frame."),
+):
+    """Write (or rewrite) the rerun recording of an existing run."""
+    import xarray as xr
+    from .replay.plots import find_timeseries
+    from .replay.record import RECORDING_NAME, write_recording
+    try:
+        src = find_timeseries(nc)
+    except FileNotFoundError as e:
+        _fail(str(e))
+    if out is None:
+        out = src.parent / (RECORDING_NAME if src.name == "timeseries.nc" else src.stem + ".rrd")
+    typer.echo(f"written: {write_recording(xr.load_dataset(src), out, every=every)}")
+
 
 
 def main():

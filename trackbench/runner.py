@@ -55,6 +55,8 @@ def run_one(sets, duration, out, name):
     sc = sc.with_overrides({"name": name})
     ds = simulate(sc)
     path = write_netcdf(ds, Path(out) / f"{name}.nc")
+    from .replay.record import maybe_write_recording
+    maybe_write_recording(ds, Path(out), name=f"{name}.rrd")
     return format_summary(ds, path)
 
 

@@ -44,7 +44,7 @@ def paper_step():
         "terrain": {"kind": "step", "height": 0.1, "first_contact_time": 0.0568},
         "lee": {"accel_order": 10, "eps_iterations": 10, "position_tol": 1e-9,
                 "max_iterations": 500, "matrix_update_angle": 1e-3},
-        "record": {"enabled": True, "every": 1},
+        "record": {"enabled": True, "every": 5},   # side-view frames: every 5th output sample
     }
 
 

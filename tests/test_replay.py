@@ -1,0 +1,242 @@
+"""Issue 5: the rerun recording (read back with rerun's own reader), the plots, `trackbench view`."""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+from rerun.chunk import RrdReader
+from typer.testing import CliRunner
+
+import trackbench as tb
+from trackbench.cli import app
+from trackbench.output import write_netcdf
+from trackbench.replay import geometry as G
+from trackbench.replay import record as R
+from trackbench.replay import view as V
+from trackbench.replay.plots import plot_run, plot_study, study_axes
+
+GEOMETRY = (R.E_CHASSIS, R.E_ARMS, R.E_WHEELS, R.E_LINKS, R.E_PINS, R.E_WHEEL_FORCE, R.E_GROUND_FORCE)
+
+
+@pytest.fixture(scope="session")
+def step_run():
+    """paper_step to 0.12 s: the step is hit at 0.0568 s, so the front of the track is on it."""
+    return tb.simulate(tb.Scenario.paper(duration=0.12))
+
+
+@pytest.fixture(scope="session")
+def run_folder(step_run, tmp_path_factory):
+    """A run folder like a study's: timeseries.nc and recording.rrd side by side."""
+    d = tmp_path_factory.mktemp("study") / "runs" / "abcdef0123"
+    write_netcdf(step_run, d / "timeseries.nc")
+    R.write_recording(step_run, d / "recording.rrd")
+    return d
+
+
+def read_temporal(path):
+    """entity path -> {column name -> list of per-row values}, rows sorted by sim_time."""
+    by_entity = {}
+    for c in RrdReader(path).stream().to_chunks():
+        if R.TIMELINE not in c.timeline_names:
+            continue
+        rb = c.to_record_batch()
+        cols = by_entity.setdefault(c.entity_path, {})
+        for name in rb.schema.names:
+            if "RowId" in name:
+                continue
+            cols.setdefault(name, []).extend(rb.column(name).to_pylist())
+    for cols in by_entity.values():
+        order = np.argsort([t.total_seconds() if hasattr(t, "total_seconds") else t for t in cols[R.TIMELINE]],
+                           kind="stable")
+        for k in cols:
+            cols[k] = [cols[k][i] for i in order]
+    return by_entity
+
+
+def static_entities(path):
+    return {c.entity_path for c in RrdReader(path).stream().to_chunks() if not c.timeline_names}
+
+
+def seconds(col):
+    return np.array([t.total_seconds() for t in col])
+
+
+def test_recording_has_every_entity_and_one_row_per_netcdf_frame(run_folder):
+    nc = xr.load_dataset(run_folder / "timeseries.nc")
+    n = nc.sizes["time"]
+    data = read_temporal(run_folder / "recording.rrd")
+    signals = [R.E_WHEEL_FY, R.E_AY, R.E_VX, R.E_TENSION, R.E_ENERGY]
+    for e in GEOMETRY + tuple(signals):
+        assert e in data, f"{e} missing from the recording"
+        t = seconds(data[e][R.TIMELINE])
+        assert len(t) == n, e
+        np.testing.assert_allclose(t, nc["time"].values, atol=1e-9)
+    static = static_entities(run_folder / "recording.rrd")
+    for e in (R.E_GROUND, R.E_PARAMS, R.E_SOLVER):
+        assert e in static
+    # per-frame instance counts: 5 wheels, 30 links, 31 pins
+    assert {len(v) for v in data[R.E_WHEELS]["Ellipses2D:centers"]} == {5}
+    assert {len(v) for v in data[R.E_LINKS]["LineStrips2D:strips"]} == {30}
+    assert {len(v) for v in data[R.E_PINS]["Points2D:positions"]} == {31}
+
+
+def test_logged_values_equal_the_dataset(run_folder, step_run):
+    data = read_temporal(run_folder / "recording.rrd")
+    got = np.array(data[R.E_WHEEL_FY]["Scalars:scalars"])      # (n, 5): one scalar per wheel
+    np.testing.assert_array_equal(got, step_run["wheel_force_y"].values)
+    energy = np.array(data[R.E_ENERGY]["Scalars:scalars"])
+    np.testing.assert_array_equal(energy[:, 0], step_run["energy_kinetic"].values)
+    np.testing.assert_array_equal(energy[:, 3], step_run["energy_balance"].values)
+    assert np.max(step_run["wheel_force_y"].values) > 1e5  # the step was hit: not a constant signal
+    got_ay = np.array([v[0] for v in data[R.E_AY]["Scalars:scalars"]])
+    np.testing.assert_array_equal(got_ay, step_run["chassis_ay"].values)
+    # the side view is logged with y negated (rerun's 2D views draw y downwards), float32
+    vec = np.array(data[R.E_WHEEL_FORCE]["Arrows2D:vectors"], dtype=float)         # (n, 5, 2)
+    f = np.stack([step_run["wheel_force_x"].values, -step_run["wheel_force_y"].values], axis=-1) * G.FORCE_SCALE
+    np.testing.assert_allclose(vec, f, rtol=1e-6, atol=1e-6)
+    pins = np.array(data[R.E_PINS]["Points2D:positions"], dtype=float)
+    np.testing.assert_allclose(pins[..., 0], step_run["pin_x"].values, atol=1e-5)
+    np.testing.assert_allclose(pins[..., 1], -step_run["pin_y"].values, atol=1e-5)
+    # link colours follow the tension
+    colors = np.array(data[R.E_LINKS]["LineStrips2D:colors"], dtype=np.uint32)
+    np.testing.assert_array_equal(colors, G.tension_rgba32(step_run["link_tension"].values))
+    # chassis outline: closed, its first corner (rear, bottom) is the rotated body point
+    hull = np.array(data[R.E_CHASSIS]["LineStrips2D:strips"], dtype=float)[:, 0]   # (n, 5, 2)
+    np.testing.assert_allclose(hull[:, 0], hull[:, -1])
+    body = np.array(json.loads(step_run.attrs["track_ends"]))
+    c, s = np.cos(step_run["chassis_pitch"].values), np.sin(step_run["chassis_pitch"].values)
+    bx, by = body[:, 0].min() - G.HULL_MARGIN, G.HULL_BOTTOM
+    np.testing.assert_allclose(hull[:, 0, 0], step_run["chassis_x"].values + c * bx - s * by, atol=1e-5)
+    np.testing.assert_allclose(-hull[:, 0, 1], step_run["chassis_y"].values + s * bx + c * by, atol=1e-5)
+
+
+def test_blueprint_is_stored(run_folder):
+    r = RrdReader(run_folder / "recording.rrd")
+    (bp,) = r.blueprints()
+    views = {}
+    for c in r.stream(store=bp).to_chunks():
+        rb = c.to_record_batch()
+        if "ViewBlueprint:space_origin" in rb.schema.names:
+            views[rb.column("ViewBlueprint:space_origin").to_pylist()[0][0]] = \
+                rb.column("ViewBlueprint:class_identifier").to_pylist()[0][0]
+    assert views.get("/world") == "2D"
+    for e in (R.E_WHEEL_FY, R.E_AY, R.E_VX):
+        assert views.get(e) == "TimeSeries"
+    assert views.get(R.E_PARAMS) == "TextDocument"
+
+
+def test_parameters_and_solver_text(step_run):
+    assert "| speed | 10.0 |" in R.parameters_text(step_run)
+    text = R.solver_text(step_run)
+    assert f"| steps | {step_run.attrs['steps']} |" in text and "peak_wheel_force_y wheel 1" in text
+
+
+def with_record(ds, **rec):
+    ds = ds.copy()
+    sc = json.loads(ds.attrs["scenario"])
+    sc["record"].update(rec)
+    ds.attrs = {**ds.attrs, "scenario": json.dumps(sc)}
+    return ds
+
+
+def test_record_switch_and_every(step_run, tmp_path):
+    off = tmp_path / "off"
+    off.mkdir()
+    assert R.maybe_write_recording(with_record(step_run, enabled=False), off) is None
+    assert list(off.iterdir()) == []
+    on = tmp_path / "on"
+    p = R.maybe_write_recording(with_record(step_run, enabled=True, every=7), on)
+    assert p == on / "recording.rrd" and [x.name for x in on.iterdir()] == ["recording.rrd"]  # no temp left
+    data = read_temporal(p)
+    n = step_run.sizes["time"]
+    idx = R.frame_indices(n, 7)
+    assert idx[-1] == n - 1 and len(idx) == len(range(0, n, 7)) + (1 if (n - 1) % 7 else 0)
+    t = seconds(data[R.E_CHASSIS][R.TIMELINE])
+    np.testing.assert_allclose(t, step_run["time"].values[idx], atol=1e-9)
+    assert len(data[R.E_WHEEL_FY][R.TIMELINE]) == n  # time series stay at full rate
+
+
+def test_run_plots_are_real_images(step_run, tmp_path):
+    import matplotlib.image as mpimg
+    paths = plot_run(step_run, tmp_path, times=(0.05, 0.1))
+    names = [p.name for p in paths]
+    assert names == ["configuration.png", "wheel_force.png", "chassis_ay.png", "chassis_vx.png", "energy.png"]
+    for p in paths:
+        img = mpimg.imread(p)
+        assert img.shape[0] > 400 and img.shape[1] > 600, p
+        ink = np.mean(np.any(img[..., :3] < 0.9, axis=-1))
+        assert ink > 0.03, f"{p.name} is nearly blank ({ink:.3f})"
+    conf = mpimg.imread(paths[0])[..., :3]
+    # the ground fill (tan) and tension colours (green around 80 kN) are drawn
+    tan = np.all(np.abs(conf - np.array([0xd8, 0xc3, 0xa0]) / 255) < 0.03, axis=-1).mean()
+    green = np.all(np.abs(conf - G.TENSION_RGB[2] / 255) < 0.06, axis=-1).mean()
+    assert tan > 0.02 and green > 0.001
+    with pytest.raises(ValueError, match="none of the times"):
+        plot_run(step_run, tmp_path / "x", times=(0.3,))
+
+
+def test_plot_run_from_a_run_folder(run_folder, tmp_path):
+    res = CliRunner().invoke(app, ["plot", str(run_folder), "--out", str(tmp_path), "--times", "0.06,0.11"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "configuration.png").stat().st_size > 20_000
+
+
+def fake_summary(folder):
+    rows = []
+    rng = np.random.default_rng(1)
+    for speed in (5.0, 10.0, 15.0):
+        for h in (0.05, 0.1):
+            row = {"run_id": f"r{speed:g}_{h:g}", "status": "completed", "status_message": "", "variant": 0,
+                   "replicate": 0, "speed": speed, "terrain.height": h, "solver": "reduced"}
+            for w in range(1, 6):
+                row[f"peak_wheel{w}_force_y"] = 1e5 * (1 + speed * h * w) + rng.uniform(0, 1e3)
+                row[f"peak_wheel{w}_force_y_time"] = 0.1
+            row.update(peak_ground_force_y=3e5 * speed * h, peak_link_tension=2e5, min_chassis_vx=speed - 1,
+                       first_contact_time=0.0568, steps=100, wall_time=0.4, solve_time=0.3)
+            rows.append(row)
+    rows[-1]["status"] = "failed"
+    folder.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame(rows).to_csv(folder / "summary.csv", index=False)
+
+
+def test_plot_study_one_figure_per_axis(tmp_path):
+    fake_summary(tmp_path / "st")
+    df = pd.read_csv(tmp_path / "st" / "summary.csv")
+    assert study_axes(df) == ["speed", "terrain.height"]  # constant solver, peaks and book-keeping left out
+    paths = plot_study(tmp_path / "st", tmp_path / "out")
+    assert [p.name for p in paths] == ["study_speed.png", "study_terrain_height.png"]
+    for p in paths:
+        assert p.stat().st_size > 20_000
+    res = CliRunner().invoke(app, ["plot", str(tmp_path / "st")])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "st" / "plots" / "study_speed.png").exists()
+
+
+def test_view_resolves_paths_and_explains_missing_display(run_folder, monkeypatch):
+    rrd = run_folder / "recording.rrd"
+    study = run_folder.parent.parent
+    assert V.resolve_recording(rrd) == rrd
+    assert V.resolve_recording(run_folder) == rrd
+    assert V.resolve_recording(study, "abcdef0123") == rrd
+    assert V.resolve_recording(study, "abc") == rrd          # unique prefix
+    with pytest.raises(V.ViewError, match="no run 'zzz'"):
+        V.resolve_recording(study, "zzz")
+    with pytest.raises(V.ViewError, match="give a run id"):
+        V.resolve_recording(study)
+    assert not V.display_available({}) and V.display_available({"WAYLAND_DISPLAY": "wayland-0"})
+    with pytest.raises(V.ViewError) as e:
+        V.open_viewer(run_folder, env={})
+    msg = str(e.value)
+    assert "no display" in msg and "rerun recording.rrd" in msg and "app.rerun.io" in msg
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    res = CliRunner().invoke(app, ["view", str(study), "abc"])
+    assert res.exit_code == 3 and "no display" in res.output
+
+
+def test_view_of_a_netcdf_writes_the_recording_beside_it(step_run, tmp_path):
+    nc = write_netcdf(step_run, tmp_path / "paper_step.nc")
+    rrd = V.resolve_recording(nc)
+    assert rrd == tmp_path / "paper_step.rrd" and rrd.stat().st_size > 100_000
