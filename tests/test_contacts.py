@@ -159,3 +159,17 @@ def test_contact_power_matches_force_times_velocity():
     fpin, fwheel, diag, _ = loads(pins, [[0.30, 0.79]], velocities=vel)
     # wheel at rest: power = force on the track . pin velocities
     assert diag[L.D_POWER] == pytest.approx(float(fpin[1] @ vel[1]), rel=1e-12)
+
+
+def test_back_of_an_obstacle_does_not_push_pins_outside_the_ground():
+    # a block from x = 1 to 2: a pin resting on the ground before it lies "behind" the
+    # block's far face (s < 0 there) but is outside the ground: only its pad acts
+    block = ((-1000, 0.0), (1.0, 0.0), (1.0, 0.05), (2.0, 0.05), (2.0, 0.0), (1000, 0.0))
+    pins = [[0.6, 0.3], [0.4, 0.015], [0.2, 0.3]]
+    fpin, _, diag, _ = loads(pins, [[5.0, 5.0]], ground=block)
+    np.testing.assert_allclose(fpin[1], [0.0, K * (HG - 0.015)], atol=1e-6)
+    # a pin inside the block (under its top, behind its far face) is pushed out of the
+    # nearest surface only
+    pins = [[1.9, 0.3], [1.7, 0.04], [1.5, 0.3]]
+    fpin, _, _, _ = loads(pins, [[5.0, 5.0]], ground=block)
+    np.testing.assert_allclose(fpin[1], [0.0, K * (HG + 0.01)], atol=1e-6)

@@ -137,3 +137,16 @@ def test_neighbour_lists_equal_full_search(paper_run):
         if skin < 1:
             assert int(m.nbr[:-1, 0].max()) < 30  # far pairs were skipped
     np.testing.assert_array_equal(out[0], out[1])
+
+
+@pytest.mark.parametrize("terrain", [
+    {"kind": "block", "height": 0.05, "length": 0.5, "first_contact_time": 0.0568},
+    {"kind": "ramp", "height": 0.2, "length": 1.0, "position": 3.0},
+    {"kind": "sequence", "obstacles": [{"kind": "step", "height": 0.05, "first_contact_time": 0.03},
+                                       {"kind": "bump", "height": 0.05, "length": 0.3, "gap": 0.5}]},
+])
+def test_other_terrains_run_with_small_residual(terrain):
+    ds = tb.simulate(tb.Scenario.from_dict({"terrain": terrain, "duration": 0.3}))
+    assert ds.attrs["status"] == "completed", ds.attrs["status_message"]
+    assert float(ds.max_energy_residual) < 1e-6
+    assert float(ds.obstacle_force.max()) > 0.0      # the obstacle was reached

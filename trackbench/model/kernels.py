@@ -153,8 +153,9 @@ def link_tensions(apos, par, lk, fpin, diag, t_off):
         dx = apos[b + 1, 0] - apos[b, 0]
         dy = apos[b + 1, 1] - apos[b, 1]
         length = math.sqrt(dx * dx + dy * dy)
-        tx = dx / length
-        ty = dy / length
+        inv = 1.0 / length
+        tx = dx * inv
+        ty = dy * inv
         lk[b, 0] = tx
         lk[b, 1] = ty
         lk[b, 2] = length
@@ -273,6 +274,17 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
     corner_force = 0.0
     for b in range(1, n_links):
         row = r_ps + b
+        # Is the pin inside the ground (below the surface at its x)? Only then may a
+        # segment it lies behind (s < 0) push it: otherwise the back of an obstacle's
+        # far face (a block's) would push pins on the ground before it from metres away.
+        inside = False
+        for j in range(nbr[row, 0]):
+            sj = nbr[row, 1 + j]
+            if seg[sj, 2] > 0.0:  # not a vertical face
+                dx = apos[b, 0] - seg[sj, 0]
+                if 0.0 <= dx <= seg[sj, 4] * seg[sj, 2]:
+                    if dx * seg[sj, 5] + (apos[b, 1] - seg[sj, 1]) * seg[sj, 6] < 0.0:
+                        inside = True
         n_below = 0
         best = -np.inf
         for j in range(nbr[row, 0]):
@@ -283,7 +295,7 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
             if lam < 0.0 or lam > seg[sj, 4]:
                 continue
             s = dx * seg[sj, 5] + dy * seg[sj, 6]
-            if s >= hg:
+            if s >= hg or (s < 0.0 and not inside):
                 continue
             if s < 0.0:
                 n_below += 1
@@ -298,7 +310,7 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
             if lam < 0.0 or lam > seg[sj, 4]:
                 continue
             s = dx * seg[sj, 5] + dy * seg[sj, 6]
-            if s >= hg:
+            if s >= hg or (s < 0.0 and not inside):
                 continue
             # a pin beyond several segments presses on the nearest one only
             if n_below >= 2 and s < best:

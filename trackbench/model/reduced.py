@@ -63,6 +63,7 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
         apos[b, 1] = q[k + 1]
         avel[b, 0] = qd[k]
         avel[b, 1] = qd[k + 1]
+    return c, s
 
 
 @njit(cache=True)
@@ -77,7 +78,7 @@ def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     nq = (y.shape[0] - 1) // 2
     q = y[:nq]
     qd = y[nq:2 * nq]
-    positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm)
+    c, s = positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm)
     track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel,
                 diag, D_WHEEL + 2 * nw)
 
@@ -88,10 +89,7 @@ def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     la = par[P_ARM_LENGTH]
     kt = par[P_TORSION_STIFFNESS]
     mp = par[P_PIN_MASS]
-    th = q[Q_PITCH]
     om = qd[Q_PITCH]
-    c = math.cos(th)
-    s = math.sin(th)
 
     # chassis block A (3x3, symmetric) and generalised force on (x, y, pitch)
     a00 = mc

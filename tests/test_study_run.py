@@ -1,0 +1,272 @@
+"""Studies end to end: CLI, resume after kill -9, failure isolation, lock, dask, reading results."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+
+import trackbench as tb
+from trackbench.study import StudyLocked, load_study, run_study, store
+from trackbench.study.summary import write_summary
+
+REPO = Path(__file__).resolve().parents[1]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+FAST = 'duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n'
+
+
+def cli(args, cwd, timeout=300):
+    return subprocess.run(CLI + args, cwd=cwd, capture_output=True, text=True, timeout=timeout)
+
+
+def files(folder):
+    """path -> (inode, mtime_ns) of every file below folder."""
+    return {str(p.relative_to(folder)): (p.stat().st_ino, p.stat().st_mtime_ns)
+            for p in Path(folder).rglob("*") if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def sweep(tmp_path_factory):
+    """The shipped speed sweep at 0.05 s through the CLI (2 workers), then a resume."""
+    d = tmp_path_factory.mktemp("sweep")
+    text = (REPO / "studies" / "speed_sweep.toml").read_text().replace("duration = 0.5", "duration = 0.05")
+    (d / "speed_sweep.toml").write_text(text.replace("solver = \"reduced\"", "solver = \"reduced\"\nrecord = { enabled = false }"))
+    first = cli(["study", "run", "speed_sweep.toml"], d)
+    snap = files(d / "results" / "speed_sweep" / "runs")
+    second = cli(["study", "run", "speed_sweep.toml"], d)
+    return d, first, snap, second
+
+
+def test_speed_sweep_cli_end_to_end(sweep):
+    d, first, _, _ = sweep
+    assert first.returncode == 0, first.stderr
+    out = d / "results" / "speed_sweep"
+    assert "15 runs, 15 run now, 0 already completed, 0 failed" in first.stdout
+    assert "[15/15]" in first.stderr and "ETA" in first.stderr
+    df = pd.read_csv(out / "summary.csv")
+    assert len(df) == 15 and set(df.status) == {"completed"}
+    pq = pd.read_parquet(out / "summary.parquet")
+    assert list(pq.columns) == list(df.columns)
+    for col in ["run_id", "status", "speed", "terrain.height", "peak_wheel1_force_y", "peak_wheel5_force_y",
+                "peak_wheel5_force_y_time", "peak_ground_force_y", "peak_ground_force_y_time", "peak_link_tension",
+                "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx", "min_chassis_vx_time",
+                "first_compression_time", "max_energy_balance_error", "steps", "wall_time"]:
+        assert col in df.columns, col
+    assert sorted(set(df.speed)) == [5.0, 7.5, 10.0, 12.5, 15.0]
+    assert (df.peak_ground_force_y > 1e5).all() and (df.steps > 0).all()
+    # a faster vehicle hits harder, at every height (first impact lies within 0.05 s)
+    piv = df.pivot(index="speed", columns="terrain.height", values="peak_ground_force_y")
+    assert (piv.loc[15.0] > piv.loc[5.0]).all()
+    assert (out / "study.toml").exists() and not list(out.rglob(".*.tmp*"))
+    for rid in df.run_id:
+        rec = json.loads((out / "runs" / rid / "run.json").read_text())
+        assert rec["status"] == "completed" and rec["run_id"] == rid and rec["model_version"]
+        assert rec["scenario"]["duration"] == 0.05
+        ds = xr.load_dataset(out / "runs" / rid / "timeseries.nc")
+        assert float(ds.peak_ground_force_y) == pytest.approx(df.set_index("run_id").loc[rid, "peak_ground_force_y"])
+        assert json.loads(ds.attrs["scenario"])["speed"] == rec["params"]["speed"]
+
+
+def test_resume_skips_completed_runs_and_leaves_them_untouched(sweep):
+    d, _, snap, second = sweep
+    assert second.returncode == 0, second.stderr
+    assert "0 run now, 15 already completed" in second.stdout
+    assert files(d / "results" / "speed_sweep" / "runs") == snap
+
+
+def test_status_and_summary_commands(sweep):
+    d = sweep[0]
+    r = cli(["study", "status", "speed_sweep.toml"], d)
+    assert r.returncode == 0 and "15 runs: 15 done, 0 failed, 0 pending" in r.stdout
+    r = cli(["study", "summary", "speed_sweep.toml"], d)
+    assert r.returncode == 0 and r.stdout.count("completed") == 15 and "ground kN" in r.stdout
+
+
+def test_open_study_and_dataset(sweep):
+    d = sweep[0]
+    df = tb.open_study(d / "speed_sweep.toml")  # relative output: resolved against the cwd
+    assert (df.status == "pending").all()       # the test's cwd is not the study's
+    df = tb.open_study(d / "results" / "speed_sweep")
+    assert len(df) == 15 and (df.status == "completed").all()
+    ds = tb.open_study(d / "results" / "speed_sweep", run=df.run_id[3][:6])
+    assert float(ds.peak_ground_force_y) == pytest.approx(df.peak_ground_force_y[3])
+    ds.close()
+    big = tb.open_study_dataset(d / "results" / "speed_sweep")
+    assert big.sizes["run"] == 15 and big.chassis_y.chunks is not None  # lazy (dask)
+    assert list(big.run.values) == list(df.run_id)
+    assert np.allclose(big.speed.values, df.speed.values)
+    assert float(big.peak_ground_force_y.max()) == pytest.approx(df.peak_ground_force_y.max())
+    big.close()
+
+
+def test_force_reruns_everything(tmp_path):
+    p = tmp_path / "f.toml"
+    p.write_text(f"[study]\nname = 'f'\n[scenario]\n{FAST}[grid]\nspeed = [6.0, 9.0]\n")
+    assert cli(["study", "run", str(p), "--workers", "1"], tmp_path).returncode == 0
+    before = files(tmp_path / "results" / "f" / "runs")
+    r = cli(["study", "run", str(p), "--workers", "1", "--force"], tmp_path)
+    assert r.returncode == 0 and "2 run now, 0 already completed" in r.stdout
+    after = files(tmp_path / "results" / "f" / "runs")
+    assert set(after) == set(before) and all(after[k] != before[k] for k in after)
+
+
+def test_failed_run_is_isolated_and_reported(tmp_path):
+    p = tmp_path / "fail.toml"
+    p.write_text(f"[study]\nname = 'fail'\n[scenario]\n{FAST}"
+                 "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n")
+    r = cli(["study", "run", str(p)], tmp_path)
+    assert r.returncode == 1
+    assert "1 of 3 runs failed" in r.stderr
+    df = pd.read_csv(tmp_path / "results" / "fail" / "summary.csv")
+    assert list(df.status) == ["completed", "failed", "completed"]
+    assert "maximum number of steps" in df.status_message[1]
+    rec = json.loads((tmp_path / "results" / "fail" / "runs" / df.run_id[1] / "run.json").read_text())
+    assert rec["status"] == "failed" and "maximum number of steps" in rec["status_message"]
+    s = cli(["study", "status", str(p)], tmp_path)
+    assert "2 done, 1 failed, 0 pending" in s.stdout and "maximum number of steps" in s.stdout
+
+
+def test_kill_9_mid_study_then_resume(tmp_path):
+    p = tmp_path / "k.toml"
+    p.write_text("[study]\nname = 'k'\n[scenario]\nduration = 0.3\nrecord = { enabled = false }\n"
+                 "[grid]\nspeed = { start = 5.0, stop = 12.0, step = 1.0 }\n")
+    out = tmp_path / "results" / "k"
+    proc = subprocess.Popen(CLI + ["study", "run", str(p), "--workers", "1"], cwd=tmp_path,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(out.glob("runs/*/run.json"))) < 2:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the whole study: the command and its workers
+    proc.wait()
+    done = [q.parent.name for q in out.glob("runs/*/run.json")]
+    assert 2 <= len(done) < 8, "the study must be killed part-way"
+    # nothing that looks complete is broken: every run.json parses, every timeseries.nc opens
+    for q in out.glob("runs/*/run.json"):
+        assert json.loads(q.read_text())["status"] == "completed"
+    for q in out.glob("runs/*/timeseries.nc"):
+        xr.load_dataset(q)
+    kept = {k: v for k, v in files(out / "runs").items() if k.split("/")[0] in done}
+    r = cli(["study", "run", str(p), "--workers", "1"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert f"{8 - len(done)} run now, {len(done)} already completed" in r.stdout
+    after = files(out / "runs")
+    assert {k: after[k] for k in kept} == kept      # completed runs untouched
+    assert not list(out.rglob(".*.tmp*"))           # leftovers of the killed run cleaned
+    df = pd.read_csv(out / "summary.csv")
+    assert len(df) == 8 and (df.status == "completed").all()
+
+
+def test_second_study_run_on_the_same_folder_exits_clearly(tmp_path):
+    p = tmp_path / "l.toml"
+    p.write_text(f"[study]\nname = 'l'\n[scenario]\n{FAST}")
+    out = tmp_path / "results" / "l"
+    with store.study_lock(out):
+        r = cli(["study", "run", str(p)], tmp_path)
+        with pytest.raises(StudyLocked):
+            run_study(p, output=out, quiet=True)
+    assert r.returncode == 3
+    assert "is in use by another `trackbench study run` (pid" in r.stderr
+    assert not (out / "runs").exists()
+    with store.study_lock(out):  # released when the holder is done
+        pass
+
+
+def test_dask_local_cluster(tmp_path):
+    pytest.importorskip("dask.distributed")
+    p = tmp_path / "d.toml"
+    p.write_text(f"[study]\nname = 'd'\noutput = 'dd'\n[scenario]\n{FAST}"
+                 "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n")
+    o = run_study(p, workers=2, executor="dask", output=tmp_path / "dd", quiet=True)
+    assert list(o.summary.status) == ["completed", "failed", "completed"] and o.failed_total == 1
+    recs = [store.read_run(tmp_path / "dd", rid) for rid in o.summary.run_id]
+    assert all(r["pid"] != os.getpid() for r in recs)
+    assert (tmp_path / "dd" / "summary.csv").exists()
+
+
+def test_replicates_statistics_and_flags(tmp_path):
+    """Fabricated run.json records: median/min/max and the 5 % spread flag."""
+    p = tmp_path / "r.toml"
+    p.write_text(f"[study]\nname = 'r'\nreplicates = 3\n[scenario]\n{FAST}[grid]\nspeed = [5.0, 6.0]\n")
+    s = load_study(p, output=tmp_path / "r")
+    assert [r.scenario["seed"] for r in s.runs] == [1, 2, 3, 1, 2, 3]
+    for r in s.runs:
+        ground = 1000.0 * (1 + (0.1 if r.variant == 0 else 0.01) * r.replicate)
+        res = {"peak_ground_force_y": ground, "peak_link_tension": 50.0, "peak_chassis_ay": 2.0,
+               "min_chassis_ay": -3.0, "min_chassis_vx": 5.0}
+        res.update({f"peak_wheel{w}_force_y": 10.0 for w in range(1, 6)})
+        store.write_json(store.run_dir(s.output, r.run_id) / "run.json",
+                         {"run_id": r.run_id, "status": "completed", "results": res})
+    df, rep = write_summary(s)
+    assert len(df) == 6 and list(rep.speed) == [5.0, 6.0]
+    assert rep.peak_ground_force_y_median.tolist() == [1100.0, 1010.0]
+    assert rep.peak_ground_force_y_min.tolist() == [1000.0, 1000.0]
+    assert rep.peak_ground_force_y_max.tolist() == [1200.0, 1020.0]
+    assert rep.sensitive.tolist() == ["peak_ground_force_y", ""]
+    assert (tmp_path / "r" / "replicates.csv").exists() and (tmp_path / "r" / "replicates.parquet").exists()
+
+
+def test_replicates_run_with_distinct_perturbed_starts(tmp_path):
+    p = tmp_path / "rr.toml"
+    p.write_text(f"[study]\nname = 'rr'\nreplicates = 2\n[scenario]\n{FAST}")
+    o = run_study(p, workers=2, output=tmp_path / "rr", quiet=True)
+    assert list(o.summary.status) == ["completed", "completed"] and len(o.replicates) == 1
+    y = [xr.load_dataset(store.run_dir(tmp_path / "rr", rid) / "timeseries.nc").pin_y[0].values
+         for rid in o.summary.run_id]
+    assert 0 < np.abs(y[0] - y[1]).max() < 1e-8   # the 1e-9 m nudge, seeded differently
+
+
+def test_open_study_dataset_aligns_different_durations(tmp_path):
+    p = tmp_path / "a.toml"
+    p.write_text("[study]\nname = 'a'\n[scenario]\noutput_interval = 0.001\nrecord = { enabled = false }\n"
+                 "[[runs]]\nduration = 0.03\n[[runs]]\nduration = 0.05\n")
+    run_study(p, workers=2, output=tmp_path / "a", quiet=True)
+    ds = tb.open_study_dataset(tmp_path / "a")
+    assert ds.sizes["run"] == 2 and ds.sizes["time"] == 51
+    cy = ds.chassis_y.load()
+    assert np.isnan(cy[0, -5:]).all() and not np.isnan(cy[1]).any() and not np.isnan(cy[0, :31]).any()
+    assert list(ds.duration.values) == [0.03, 0.05]
+    ds.close()
+    # the folder is read from its runs.json, not by expanding study.toml again (defaults may change)
+    (tmp_path / "a" / "study.toml").write_text("[scenario]\nduration = 0.07\n")
+    df = tb.open_study(tmp_path / "a")
+    assert list(df.status) == ["completed", "completed"] and list(df.duration) == [0.03, 0.05]
+
+
+def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
+    """A recording writer that raises: the run completes and run.json says why."""
+    import types
+    from trackbench.study.executors import execute_run
+    mod = types.ModuleType("trackbench.replay.record")
+
+    def boom(ds, path, every=1):
+        Path(path).write_text("partial")
+        raise RuntimeError("disk full")
+    mod.write_recording = boom
+    monkeypatch.setitem(sys.modules, "trackbench.replay.record", mod)
+    s = load_study(_write(tmp_path, "[scenario]\nduration = 0.02\noutput_interval = 0.001\n"), output=tmp_path / "o")
+    run = s.runs[0]
+    task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}}
+    rec = execute_run(task)
+    assert rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]
+    assert sorted(os.listdir(store.run_dir(s.output, run.run_id))) == ["run.json", "timeseries.nc"]
+
+    def ok(ds, path, every=1):
+        Path(path).write_text(f"rrd every={every}")
+    mod.write_recording = ok
+    rec = execute_run(task)
+    assert rec["recording"] == "recording.rrd" and "recording_error" not in rec
+    every = run.scenario["record"]["every"]
+    assert (store.run_dir(s.output, run.run_id) / "recording.rrd").read_text() == f"rrd every={every}"
+
+
+def _write(tmp_path, text):
+    p = tmp_path / "x.toml"
+    p.write_text(text)
+    return p

@@ -1,0 +1,174 @@
+"""Reading a study: the pandas summary, replicate statistics, open_study / open_study_dataset."""
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from . import store
+from .spec import Run, Study, load_study
+
+SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
+PEAKS = ("peak_ground_force_y", "peak_link_tension", "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx")
+TAIL = ("first_contact_time", "first_compression_time", "max_energy_balance_error", "max_energy_residual")
+
+
+def _wheels(study):
+    n = {int(r.scenario["vehicle"]["n_wheels"]) for r in study.runs}
+    return max(n)
+
+
+def quantities(study):
+    """Per-run peak quantities, in summary order (replicate statistics use these)."""
+    return [f"peak_wheel{w}_force_y" for w in range(1, _wheels(study) + 1)] + list(PEAKS)
+
+
+def summary_frame(study):
+    """One row per run of the study (pending when it has not run), from the runs' run.json."""
+    qs = quantities(study)
+    timed = []
+    for q in qs:
+        timed += [q, q + "_time"]
+    rows = []
+    for run in study.runs:
+        rec = store.read_run(study.output, run.run_id) or {"status": "pending", "status_message": ""}
+        res = rec.get("results") or {}
+        row = {"run_id": run.run_id, "status": rec["status"], "status_message": rec.get("status_message", ""),
+               "variant": run.variant, "replicate": run.replicate}
+        row.update({n: run.params.get(n) for n in study.param_names})
+        row.update({k: res.get(k) for k in timed + list(TAIL)})
+        for k in ("steps", "rejected_steps", "t_final", "wall_time", "solve_time"):
+            row[k] = rec.get(k)
+        rows.append(row)
+    df = pd.DataFrame(rows)
+    num = timed + list(TAIL) + ["t_final", "wall_time", "solve_time"]
+    df[num] = df[num].astype(float)
+    for k in ("steps", "rejected_steps"):
+        df[k] = df[k].astype("Int64")
+    df.attrs.update(study=study.name, study_dir=str(study.output))
+    return df
+
+
+def replicate_frame(study, df):
+    """One row per variant: median, min, max and relative spread of every peak over its completed
+    replicates; ``sensitive`` lists the quantities whose spread exceeds 5 %."""
+    params = [p for p in study.param_names if p != "seed"]
+    rows = []
+    for v, g in df.groupby("variant", sort=True):
+        ok = g[g.status == "completed"]
+        row = {"variant": v, **{p: g[p].iloc[0] for p in params},
+               "replicates": len(g), "completed": len(ok)}
+        flagged = []
+        for q in quantities(study):
+            x = ok[q].dropna()
+            med = float(x.median()) if len(x) else np.nan
+            lo, hi = (float(x.min()), float(x.max())) if len(x) else (np.nan, np.nan)
+            spread = (hi - lo) / abs(med) if len(x) and med != 0 else np.nan
+            row.update({f"{q}_median": med, f"{q}_min": lo, f"{q}_max": hi, f"{q}_spread": spread})
+            if spread > SPREAD_LIMIT:
+                flagged.append(q)
+        row["sensitive"] = " ".join(flagged)
+        rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def write_summary(study):
+    """Rebuild and write summary.csv (.parquet) (and replicates.csv); returns the frames."""
+    df = summary_frame(study)
+    store.write_table(df, study.output / "summary")
+    rep = None
+    if study.replicates > 1:
+        rep = replicate_frame(study, df)
+        store.write_table(rep, study.output / "replicates")
+    return df, rep
+
+
+def format_table(df, rep=None, params=()):
+    """A screen-sized table: forces in kN."""
+    show = pd.DataFrame({"run": df.run_id.str[:8], "status": df.status})
+    for p in params:
+        show[p] = df[p]
+    wheels = [c for c in df.columns if c.startswith("peak_wheel") and not c.endswith("_time")]
+    for c in wheels:
+        show["w" + c[len("peak_wheel"):-len("_force_y")] + " kN"] = df[c] / 1e3
+    show["ground kN"] = df.peak_ground_force_y / 1e3
+    show["tension kN"] = df.peak_link_tension / 1e3
+    show["ay min"] = df.min_chassis_ay
+    show["ay max"] = df.peak_chassis_ay
+    show["vx min"] = df.min_chassis_vx
+    show["compr s"] = df.first_compression_time
+    show["wall s"] = df.wall_time
+    text = show.to_string(index=False, float_format=lambda x: f"{x:.4g}", na_rep="-")
+    bad = df[df.status == "failed"]
+    for _, r in bad.iterrows():
+        text += f"\nfailed {r.run_id}: {r.status_message}"
+    if rep is not None:
+        cols = [p for p in params if p != "seed"] + ["completed"]
+        t = rep[cols].copy()
+        t["ground kN median [min, max]"] = [
+            f"{a / 1e3:.4g} [{b / 1e3:.4g}, {c / 1e3:.4g}]" for a, b, c in
+            zip(rep.peak_ground_force_y_median, rep.peak_ground_force_y_min, rep.peak_ground_force_y_max)]
+        t["spread > 5 %"] = rep.sensitive.replace("", "-")
+        text += "\n\nreplicates (median, min, max over seeds; full table in replicates.csv):\n"
+        text += t.to_string(index=False)
+    return text
+
+
+def _study_of(path):
+    """A study file, or a results folder (its runs.json, written by `study run`)."""
+    path = Path(path)
+    if not path.is_dir():
+        return load_study(path)
+    m = store.read_json(path / "runs.json")
+    if m is None:
+        return load_study(path / "study.toml", output=path)
+    study = Study(name=m["name"], description=m["description"], source=path / "study.toml", output=path,
+                  replicates=m["replicates"], base={}, param_names=m["param_names"])
+    study.runs = [Run(**r) for r in m["runs"]]
+    return study
+
+
+def open_run(path, run):
+    """One run's Dataset (xarray.open_dataset) by run id, id prefix or row number."""
+    import xarray as xr
+    study = _study_of(path)
+    ids = [r.run_id for r in study.runs]
+    if isinstance(run, (int, np.integer)):
+        rid = ids[run]
+    else:
+        match = [i for i in ids if i.startswith(str(run))]
+        if len(match) != 1:
+            raise KeyError(f"run {run!r} matches {len(match)} runs of study {study.name}")
+        rid = match[0]
+    return xr.open_dataset(store.run_dir(study.output, rid) / "timeseries.nc")
+
+
+def open_study(path, run=None):
+    """The summary of a study (a study file or its results folder) as a pandas DataFrame,
+    rebuilt from the runs' run.json; with ``run`` (id, id prefix or row number) that run's
+    Dataset instead. ``df.attrs['study_dir']`` is the results folder."""
+    if run is not None:
+        return open_run(path, run)
+    return summary_frame(_study_of(path))
+
+
+def open_study_dataset(path, status=("completed", "failed")):
+    """All runs' time histories stacked along a ``run`` dimension, opened lazily (dask) with
+    xarray.open_mfdataset; runs of different durations are aligned on time (NaN-padded).
+    The study's parameters and each run's status become coordinates along ``run``."""
+    import xarray as xr
+    study = _study_of(path)
+    df = summary_frame(study)
+    df = df[df.status.isin(status)]
+    paths = [store.run_dir(study.output, r) / "timeseries.nc" for r in df.run_id]
+    keep = [p.exists() for p in paths]
+    df, paths = df[keep], [p for p, k in zip(paths, keep) if k]
+    if not paths:
+        raise FileNotFoundError(f"no run of study {study.name} has a timeseries.nc yet")
+    ds = xr.open_mfdataset(paths, combine="nested", concat_dim="run", join="outer", data_vars="all",
+                           coords="minimal", compat="override", combine_attrs="drop_conflicts",
+                           parallel=False)
+    coords = {"run": ("run", df.run_id.to_numpy()), "status": ("run", df.status.to_numpy())}
+    for p in study.param_names:
+        coords[p] = ("run", df[p].to_numpy())
+    return ds.assign_coords(coords)
