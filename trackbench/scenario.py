@@ -34,7 +34,7 @@ def paper_step():
         "gravity": GRAVITY,
         "solver": "reduced",
         "method": "dopri5",
-        "tolerance": 1e-8,
+        "tolerance": 1e-9,
         "output_interval": 1e-4,
         "max_steps": 2_000_000,
         "perturbation": 0.0,     # m: seeded nudge of the free pins (study replicates)

@@ -9,6 +9,7 @@ iteration and computed afterwards.
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 
 from . import layout as L
 from .kernels import allocate_neighbours, track_loads
@@ -79,7 +80,7 @@ def _lower_hull(points):
 def initial_track(ends_world, wheel_centres, rho, n_links):
     """Pins spread evenly along the taut path: the lower convex hull of the track ends
     and the wheel circles of radius rho (wheel radius + pad). Pin 0 is the front end."""
-    ang = np.linspace(0.0, 2 * np.pi, 721)[:-1]
+    ang = np.linspace(0.0, 2 * np.pi, 361)[:-1]
     circ = [c + rho * np.column_stack([np.cos(ang), np.sin(ang)]) for c in wheel_centres]
     hull = _lower_hull(np.vstack([ends_world] + circ))
     hull = hull[::-1]  # front (largest x) to rear
@@ -115,36 +116,83 @@ class _Problem:
         q[L.pin_offset(self.nw):] = u[2:]
         return q
 
+    def _args(self):
+        return (self.phi, self.par, self.arms, self.ends, self.seg, self.corners, self.nbr,
+                self.ref, self.work, self.diag)
+
+    def residual(self, u):
+        """(vertical force, moment of chassis + arms, pin forces); horizontal force; arm moments."""
+        r = np.empty(u.size)
+        arm_moment = np.empty(self.nw)
+        fx = _residual(u, *self._args(), r, arm_moment)
+        return r, fx, arm_moment
+
+    def jacobian(self, u, h=1e-7):
+        J = np.empty((u.size, u.size))
+        _jacobian(u, h, *self._args(), J)
+        return J
+
     def loads(self, q):
         apos, avel, fpin, fwheel, wc, wv, lk, arm = self.work
-        zero = np.zeros(self.nq)
-        positions(q, zero, self.par, self.arms, self.ends, apos, avel, wc, wv, arm)
+        positions(q, np.zeros(self.nq), self.par, self.arms, self.ends, apos, avel, wc, wv, arm)
         track_loads(apos, avel, wc, wv, self.par, self.seg, self.corners, self.nbr, self.ref,
                     lk, fpin, fwheel, self.diag, L.diag_tension(self.nw))
         return apos, fpin, fwheel, wc
 
-    def residual(self, u):
-        """(vertical force, moment of chassis + arms, pin forces); and arm moments."""
-        q = self.q_of(u)
-        apos, fpin, fwheel, wc = self.loads(q)
-        g = self.par[L.P_GRAVITY]
-        ma = self.par[L.P_ARM_MASS]
-        n = self.n_links
-        xc, yc = q[L.Q_X], q[L.Q_Y]
-        fy = fpin[0, 1] + fpin[n, 1] + fwheel[:, 1].sum() - (self.par[L.P_CHASSIS_MASS] + self.nw * ma) * g
-        fx = fpin[0, 0] + fpin[n, 0] + fwheel[:, 0].sum()
-        mom = 0.0
-        for b in (0, n):
-            mom += (apos[b, 0] - xc) * fpin[b, 1] - (apos[b, 1] - yc) * fpin[b, 0]
-        wfy = fwheel[:, 1] - ma * g
-        mom += np.sum((wc[:, 0] - xc) * wfy - (wc[:, 1] - yc) * fwheel[:, 0])
-        pins = fpin[1:n].copy()
-        pins[:, 1] -= self.par[L.P_PIN_MASS] * g
-        c, s = np.cos(q[L.Q_PITCH]), np.sin(q[L.Q_PITCH])
-        piv = np.column_stack([xc + c * self.arms[:, 0] - s * self.arms[:, 1],
-                               yc + s * self.arms[:, 0] + c * self.arms[:, 1]])
-        arm_moment = (wc[:, 0] - piv[:, 0]) * wfy - (wc[:, 1] - piv[:, 1]) * fwheel[:, 0]
-        return np.concatenate([[fy, mom], pins.ravel()]), fx, arm_moment
+
+@njit(cache=True)
+def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, arm_moment):
+    """Force balance of every free pin, vertical force and moment of chassis + arms
+    (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
+    apos, avel, fpin, fwheel, wc, wv, lk, arm = work
+    nw = arms.shape[0]
+    n = apos.shape[0] - 1
+    nq = L.Q_ARM + nw + 2 * (n - 1)
+    q = np.zeros(nq)
+    q[L.Q_Y] = u[0]
+    q[L.Q_PITCH] = u[1]
+    q[L.Q_ARM:L.Q_ARM + nw] = phi
+    q[L.Q_ARM + nw:] = u[2:]
+    c, s = positions(q, np.zeros(nq), par, arms, ends, apos, avel, wc, wv, arm)
+    track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, L.D_WHEEL + 2 * nw)
+    g = par[L.P_GRAVITY]
+    ma = par[L.P_ARM_MASS]
+    yc = u[0]
+    fy = fpin[0, 1] + fpin[n, 1] - (par[L.P_CHASSIS_MASS] + nw * ma) * g
+    fx = fpin[0, 0] + fpin[n, 0]
+    mom = 0.0
+    for b in (0, n):
+        mom += apos[b, 0] * fpin[b, 1] - (apos[b, 1] - yc) * fpin[b, 0]
+    for i in range(nw):
+        wfy = fwheel[i, 1] - ma * g
+        fy += fwheel[i, 1]
+        fx += fwheel[i, 0]
+        mom += wc[i, 0] * wfy - (wc[i, 1] - yc) * fwheel[i, 0]
+        px = c * arms[i, 0] - s * arms[i, 1]
+        py = yc + s * arms[i, 0] + c * arms[i, 1]
+        arm_moment[i] = (wc[i, 0] - px) * wfy - (wc[i, 1] - py) * fwheel[i, 0]
+    r[0] = fy
+    r[1] = mom
+    for b in range(1, n):
+        r[2 * b] = fpin[b, 0]
+        r[2 * b + 1] = fpin[b, 1] - par[L.P_PIN_MASS] * g
+    return fx
+
+
+@njit(cache=True)
+def _jacobian(u, h, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, J):
+    """Central finite differences of _residual."""
+    rp = np.empty(u.size)
+    rm = np.empty(u.size)
+    am = np.empty(arms.shape[0])
+    up = u.copy()
+    for k in range(u.size):
+        up[k] = u[k] + h
+        _residual(up, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, rp, am)
+        up[k] = u[k] - h
+        _residual(up, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, rm, am)
+        up[k] = u[k]
+        J[:, k] = (rp - rm) / (2.0 * h)
 
 
 def solve_equilibrium(vehicle, track, gravity, tol_rel=1e-12, max_iter=60):
@@ -164,15 +212,7 @@ def solve_equilibrium(vehicle, track, gravity, tol_rel=1e-12, max_iter=60):
     it = 0
     while norm > target and it < max_iter:
         it += 1
-        J = np.empty((u.size, u.size))
-        h = 1e-7
-        for k in range(u.size):
-            up = u.copy()
-            up[k] += h
-            um = u.copy()
-            um[k] -= h
-            J[:, k] = (P.residual(up)[0] - P.residual(um)[0]) / (2 * h)
-        du = np.linalg.solve(J, -r)
+        du = np.linalg.solve(P.jacobian(u), -r)
         lam = 1.0
         while True:
             un = u + lam * du

@@ -88,6 +88,15 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
         _up(peaks, PK_WHEEL_FY + i, diag[D_WHEEL + 2 * i + 1], t)
     _up(peaks, PK_GROUND_FY, diag[D_GROUND_FY], t)
     _up(peaks, PK_TENSION_MAX, diag[D_MAX_TENSION], t)
+    if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
+        # the crossing time, linear between the last two steps (history holds -T_min)
+        f0 = -peaks[PK_TENSION_MIN, 4]
+        t0 = peaks[PK_TENSION_MIN, 5]
+        tc = t
+        if f0 > 0.0 and t0 < t:
+            tc = t0 + f0 / (f0 - diag[D_MIN_TENSION]) * (t - t0)
+        peaks[PK_FIRST_COMPRESSION, 0] = 1.0
+        peaks[PK_FIRST_COMPRESSION, 1] = tc
     _down(peaks, PK_TENSION_MIN, diag[D_MIN_TENSION], t)
     _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t)
     _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t)
@@ -97,9 +106,6 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
     if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:
         peaks[PK_FIRST_CORNER, 0] = 1.0
         peaks[PK_FIRST_CORNER, 1] = t
-    if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
-        peaks[PK_FIRST_COMPRESSION, 0] = 1.0
-        peaks[PK_FIRST_COMPRESSION, 1] = t
 
 
 @njit(cache=True)
