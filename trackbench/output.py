@@ -166,6 +166,7 @@ def write_netcdf(ds, path, compress=False):
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
+        os.chmod(tmp, 0o644)  # mkstemp made it private; results are for sharing
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

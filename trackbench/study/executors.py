@@ -103,12 +103,25 @@ def crashed(task, exc):
 
 
 def _warm():
-    """Pool initializer: import the package, netCDF4 and xarray's backends once per worker."""
+    """Pool initializer: import the package, netCDF4 and xarray's backends once per worker,
+    load the compiled kernels from the numba cache and set up netCDF and rerun (a 1 ms run
+    written to a temporary folder: ~1 s the first time in a process, which would otherwise
+    land on the worker's first run)."""
     import netCDF4  # noqa: F401
     import xarray
 
-    import trackbench.simulate  # noqa: F401
+    import tempfile
+
+    import trackbench
     xarray.backends.list_engines()
+    try:  # warming is an optimisation only; a real run reports real errors
+        ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
+        with tempfile.TemporaryDirectory() as tmp:
+            store.write_timeseries(ds, Path(tmp) / "warm.nc")
+            from ..replay.record import write_recording
+            write_recording(ds, Path(tmp) / "warm.rrd")
+    except Exception:
+        pass
 
 
 def run_local(tasks, workers=2):
