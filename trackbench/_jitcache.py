@@ -1,0 +1,40 @@
+"""Where numba keeps the compiled kernels.
+
+numba's own cache checks only the source file of each compiled function, not the files
+of the functions it calls and inlines: after an upgrade (or a `git pull` on an editable
+install) that changed only `model/kernels.py`, the cached time loop would still hold the
+old contact kernels. So the cache lives in a folder named by a hash of the whole package
+source (~/.cache/trackbench/numba/<hash>); the last few folders are kept. Setting
+NUMBA_CACHE_DIR yourself overrides this.
+"""
+
+import hashlib
+import os
+import shutil
+from pathlib import Path
+
+KEEP = 3
+
+
+def configure():
+    if "NUMBA_CACHE_DIR" in os.environ:
+        return
+    root = Path(__file__).parent
+    digest = hashlib.sha1()
+    for path in sorted(root.rglob("*.py")):
+        digest.update(path.relative_to(root).as_posix().encode())
+        digest.update(path.read_bytes())
+    base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "trackbench" / "numba"
+    target = base / digest.hexdigest()[:16]
+    try:
+        target.mkdir(parents=True, exist_ok=True)
+        os.utime(target)
+        old = sorted((p for p in base.iterdir() if p.is_dir() and p != target),
+                     key=lambda p: p.stat().st_mtime, reverse=True)[KEEP - 1:]
+        for p in old:
+            shutil.rmtree(p, ignore_errors=True)
+    except OSError:
+        return  # not writable: numba falls back to __pycache__ / its own rules
+    os.environ["NUMBA_CACHE_DIR"] = str(target)
+    import numba  # noqa: E402  (numba may already be imported: set its live config too)
+    numba.config.CACHE_DIR = str(target)
