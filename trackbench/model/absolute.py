@@ -52,7 +52,7 @@ def inverse_mass(par, n_wheels, n_links):
     return 1.0 / m
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def from_reduced(y, par, arms, z, zd):
     """Reduced state (q, qd, W) -> absolute z, zd; returns W."""
     nw = arms.shape[0]
@@ -87,7 +87,7 @@ def from_reduced(y, par, arms, z, zd):
     return y[2 * nq]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def to_reduced(z, zd, work, nw, y):
     """Absolute z, zd and contact work -> reduced (q, qd, W): phi_i = beta_i - theta."""
     nq = (y.shape[0] - 1) // 2
@@ -105,7 +105,7 @@ def to_reduced(z, zd, work, nw, y):
     y[2 * nq] = work
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def joint_vectors(z, par, arms, geo):
     """Per joint i: geo[i] = (r_x, r_y, l cos beta, l sin beta) with r = R(theta) p_i.
     Then dr_i = (-r_y, r_x) and d(l e_i)/d beta = (-l sin beta, l cos beta)."""
@@ -120,7 +120,7 @@ def joint_vectors(z, par, arms, geo):
         geo[i, 3] = la * math.sin(beta)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def phi(z, geo, out):
     """Position constraints Phi (Eq. 1), 2 per joint; geo from joint_vectors(z)."""
     for i in range(geo.shape[0]):
@@ -129,7 +129,7 @@ def phi(z, geo, out):
         out[2 * i + 1] = z[1] + geo[i, 1] - z[j + 1] + geo[i, 3]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def phi_q_times(geo, u, out):
     """out = Phi_q u (u: body part of a velocity or acceleration vector)."""
     for i in range(geo.shape[0]):
@@ -138,7 +138,7 @@ def phi_q_times(geo, u, out):
         out[2 * i + 1] = u[1] + geo[i, 0] * u[2] - u[j + 1] + geo[i, 2] * u[j + 2]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def add_phi_qt(geo, lam, scale, out):
     """out += scale * Phi_q^T lambda (body components only)."""
     for i in range(geo.shape[0]):
@@ -153,7 +153,7 @@ def add_phi_qt(geo, lam, scale, out):
         out[j + 2] += -geo[i, 3] * lx + geo[i, 2] * ly
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def gamma(zd, geo, out):
     """Right side of the acceleration constraint: Phi_q zdd = gamma = theta'^2 r_i + beta_i'^2 l e_i,
     so the error of Eq. (14) is v = gamma - Phi_q zdd."""
@@ -164,7 +164,7 @@ def gamma(zd, geo, out):
         out[2 * i + 1] = w2 * geo[i, 1] + b2 * geo[i, 3]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def constraint_matrix(geo, minv, G):
     """G = Phi_q M^-1 Phi_q^T (the paper's C up to the factors of Eqs. 17-19)."""
     nw = geo.shape[0]
@@ -188,7 +188,7 @@ def constraint_matrix(geo, minv, G):
                 G[2 * i + r, 2 * i + k] += ia * si[r] * si[k] + (ma if r == k else 0.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, F, fc, diag):
     """F = applied generalised forces (no lambda) at z; fc = contact-only force on every
     pin (tension removed), fwheel (in work) = contact force on each wheel; diag filled by
@@ -255,7 +255,7 @@ def applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, F, fc, 
         fc[b + 1, 1] += tn * lk[b, 1]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def contact_power(z, zd, ends, fc, fw, nw):
     """Power of the contact forces fc (on pins), fw (on wheels) at velocity zd; the same
     sum track_loads forms for D_POWER (pins 0 and n_links move with the chassis)."""
@@ -277,7 +277,7 @@ def contact_power(z, zd, ends, fc, fw, nw):
     return p
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def finish_diag(z, zd, zdd, par, arms, power, diag):
     """Fill what reduced_rhs fills beyond track_loads: kinetic, torsion and gravity
     energy, contact power and chassis acceleration."""

@@ -140,7 +140,7 @@ class _Problem:
         return apos, fpin, fwheel, wc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, arm_moment):
     """Force balance of every free pin, vertical force and moment of chassis + arms
     (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
@@ -179,7 +179,7 @@ def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, ar
     return fx
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _jacobian(u, h, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, J):
     """Central finite differences of _residual."""
     rp = np.empty(u.size)

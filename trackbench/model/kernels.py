@@ -30,7 +30,7 @@ from .layout import (
 )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _seg_dist2(px, py, ax, ay, bx, by):
     """Squared distance from point P to segment AB."""
     ex = bx - ax
@@ -45,7 +45,7 @@ def _seg_dist2(px, py, ax, ay, bx, by):
     return dx * dx + dy * dy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def build_neighbours(apos, wc, par, seg, corners, nbr):
     """Fill the candidate lists: every pair that could touch while no pin or wheel
     moves more than half the skin from where it is now."""
@@ -108,7 +108,7 @@ def build_neighbours(apos, wc, par, seg, corners, nbr):
         nbr[r_ps + b, 0] = n
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
     """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
     (so the lists always hold every pair that can touch: results equal a full search)."""
@@ -140,12 +140,14 @@ def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
         nbr[nbr.shape[0] - 1, 0] += 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def link_tensions(apos, par, lk, fpin, diag, t_off):
-    """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; adds the pull on
-    both pins to fpin, stores t and length in lk and T in diag[t_off + b]."""
+    """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; sets fpin to the pull
+    on every pin, stores t and length in lk and T in diag[t_off + b]."""
     k = par[P_LINK_STIFFNESS]
     l0 = par[P_LINK_LENGTH]
+    fpin[0, 0] = 0.0
+    fpin[0, 1] = 0.0
     energy = 0.0
     tmin = np.inf
     tmax = -np.inf
@@ -167,14 +169,14 @@ def link_tensions(apos, par, lk, fpin, diag, t_off):
         tmax = max(tmax, tension)
         fpin[b, 0] += tension * tx
         fpin[b, 1] += tension * ty
-        fpin[b + 1, 0] -= tension * tx
-        fpin[b + 1, 1] -= tension * ty
+        fpin[b + 1, 0] = -tension * tx  # first force on pin b+1: no need to zero fpin
+        fpin[b + 1, 1] = -tension * ty
     diag[D_E_TENSION] = energy
     diag[D_MIN_TENSION] = tmin
     diag[D_MAX_TENSION] = tmax
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _link_load(fpin, avel, b, d0, length, fx, fy):
     """Eq. (7): split a force on link b at distance d0 from pin b to pins b and b+1;
     returns the power of the split force."""
@@ -187,7 +189,7 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
     return (w0 * avel[b, 0] + w1 * avel[b + 1, 0]) * fx + (w0 * avel[b, 1] + w1 * avel[b + 1, 1]) * fy
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
     """Road wheel against link (Fig. 3, Eq. 4) and against pin in the wedge (Fig. 4)."""
     nw = wc.shape[0]
@@ -254,7 +256,7 @@ def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
     diag[D_POWER] += power
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
     """Pin on ground segment (Fig. 5 left, Eq. 6), ground corner on link (Fig. 5 right)
     and corner on pin in the wedge (Fig. 6)."""
@@ -278,28 +280,27 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
         # segment it lies behind (s < 0) push it: otherwise the back of an obstacle's
         # far face (a block's) would push pins on the ground before it from metres away.
         inside = False
-        for j in range(nbr[row, 0]):
-            sj = nbr[row, 1 + j]
-            if seg[sj, 2] > 0.0:  # not a vertical face
-                dx = apos[b, 0] - seg[sj, 0]
-                if 0.0 <= dx <= seg[sj, 4] * seg[sj, 2]:
-                    if dx * seg[sj, 5] + (apos[b, 1] - seg[sj, 1]) * seg[sj, 6] < 0.0:
-                        inside = True
         n_below = 0
-        best = -np.inf
+        best = -np.inf          # largest s over all candidates
+        best_outside = -np.inf  # largest s >= 0
         for j in range(nbr[row, 0]):
             sj = nbr[row, 1 + j]
             dx = apos[b, 0] - seg[sj, 0]
             dy = apos[b, 1] - seg[sj, 1]
-            lam = dx * seg[sj, 2] + dy * seg[sj, 3]
-            if lam < 0.0 or lam > seg[sj, 4]:
-                continue
             s = dx * seg[sj, 5] + dy * seg[sj, 6]
-            if s >= hg or (s < 0.0 and not inside):
+            if s < 0.0 and seg[sj, 2] > 0.0 and 0.0 <= dx <= seg[sj, 4] * seg[sj, 2]:
+                inside = True  # below a non-vertical segment, within its x-range
+            lam = dx * seg[sj, 2] + dy * seg[sj, 3]
+            if lam < 0.0 or lam > seg[sj, 4] or s >= hg:
                 continue
             if s < 0.0:
                 n_below += 1
+            else:
+                best_outside = max(best_outside, s)
             best = max(best, s)
+        if not inside:
+            n_below = 0
+            best = best_outside
         if best == -np.inf:
             continue
         for j in range(nbr[row, 0]):
@@ -384,13 +385,13 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
     diag[D_POWER] += power
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off):
-    """All forces of the track model for given pin and wheel positions/velocities:
+    """All forces of the track model for given pin and wheel positions/velocities
+    (fpin is overwritten, tension first):
     tension and contact forces on the pins (fpin, pins 0 and n_links included),
     contact forces on the wheels (fwheel), energies, power and status in diag.
     Gravity is left to the caller."""
-    fpin[:, :] = 0.0
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
     refresh_neighbours(apos, wc, par, seg, corners, nbr, ref)

@@ -26,7 +26,7 @@ def allocate_work(n_wheels, n_links):
             np.zeros((n_links, 3)), np.zeros((n_wheels, 6)))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
     """Pin and wheel-centre positions and velocities from the reduced state; keeps
     cos and sin of each arm's absolute angle in arm[:, 4:6] for the caller."""
@@ -66,7 +66,7 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
     return c, s
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     """ydot = f(y) for y = (q, qd, W); fills diag (forces, energies, status).
 

@@ -24,7 +24,7 @@ from numba import njit
 from ..model.absolute import add_phi_qt, gamma, phi_q_times
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def inf_norm(G):
     g = 0.0
     for i in range(G.shape[0]):
@@ -35,7 +35,7 @@ def inf_norm(G):
     return g
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     """Fill An (= A_n / w_n) for C_1 = G / ||G||_inf; returns (alpha_n, ||G||_inf)."""
     m = G.shape[0]
@@ -73,7 +73,7 @@ def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     return 2.0 / (1.0 + eps), gn
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def update(lam, An, v, scale):
     """Eq. (15): lam -= scale * A_n v (scale = alpha / ||C||_inf)."""
     m = lam.shape[0]
@@ -84,7 +84,7 @@ def update(lam, An, v, scale):
         lam[i] -= scale * acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def max_abs(v):
     e = 0.0
     for i in range(v.shape[0]):
@@ -92,7 +92,7 @@ def max_abs(v):
     return e
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def norm2(v):
     s = 0.0
     for i in range(v.shape[0]):
@@ -100,7 +100,7 @@ def norm2(v):
     return math.sqrt(s)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
     """zdd (body part) = M^-1 (F - Phi_q^T lam); v = Eq. (14) error = gamma - Phi_q zdd."""
     for k in range(nbody):
@@ -113,7 +113,7 @@ def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
         v[i] = gam[i] - v[i]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def acceleration_level(F, geo, zd, minv, lam, An, alpha, gn, tol, max_it, nbody, zdd, gam, v):
     """Step 4: iterate lam with the acceleration error Eq. (14) (C = G, Eq. 19).
     Returns (iterations, final max |v|); iterations = -1 if not converged."""
@@ -129,7 +129,7 @@ def acceleration_level(F, geo, zd, minv, lam, An, alpha, gn, tol, max_it, nbody,
     return -1, err
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     """Eq. (20): n_iter plain iterations (n = 1, alpha = 1.9) at the acceleration level;
     returns eps-bar-1 (clipped to (0, 1])."""
@@ -149,7 +149,7 @@ def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     return min(1.0, max(est, 1e-6))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def velocity_level(zd, geo_end, geos, bp, c, h, minv, lam, An, alpha, gn, tol, max_it, nbody, dl, u, v):
     """Step 3: with the stage forces of step 1 held, the body velocity at t + h depends on
     the end value lam of the multipliers (linear over the step) through

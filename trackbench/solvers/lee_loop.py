@@ -51,7 +51,7 @@ L_IT_POS, L_IT_VEL, L_IT_ACC, L_PASSES, L_REJ_ERROR, L_REJ_CONSTRAINT, L_EPS1, \
 N_L = 12
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0, h_max, h_min, max_steps,
                   n_acc, n_eps, ptol, max_it, rebuild_angle, minv, par, arms, ends, seg, corners, nbr, ref, work,
                   out_y, out_d, out_x, out_lam, peaks, stats, lstats):

@@ -19,7 +19,7 @@ from ..model.absolute import add_phi_qt, applied_forces, contact_power, joint_ve
 from .monitor import hermite_second_order
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corners, nbr, ref, work,
              Fst, fcs, fws, geos, diags, lam_s, Y, zd_new):
     """Stages 2..s of the RKN pair with lambda linear from lam0 to lam1 (stage 1, K[0],
@@ -54,7 +54,7 @@ def rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corn
         zd_new[k] = zd[k] + h * acc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     """RMS over positions and velocities of the embedded estimate (h^2 sum eb k, h sum ebp k)
     scaled by atol + rtol max(|old|, |new|)."""
@@ -74,7 +74,7 @@ def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     return math.sqrt(s / (2 * nz))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def work_increment(ya, fa, yb, fb, h, bp, c, fcs, fws, ends, nw, p_start, p_end, yo):
     """Contact work over the step: W' = P(t) = contact force . velocity, integrated by the
     pair's velocity weights, h sum_j bp_j P_j (exact for polynomials of degree 5 in time):

@@ -12,20 +12,20 @@ from ..model.layout import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def energy_balance(diag):
     """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
     return (diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_PAD_WHEEL]
             + diag[D_E_PAD_GROUND] + diag[D_E_GRAVITY])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def energy_residual(diag, work):
     """Kinetic + torsion + tension + gravity - work of the contact forces (continuous)."""
     return diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_GRAVITY] - work
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def init_peaks(peaks):
     peaks[:, 0] = -np.inf
     peaks[:, 1] = np.nan
@@ -39,14 +39,14 @@ def init_peaks(peaks):
     peaks[PK_ENERGY_RESIDUAL, 0] = 0.0
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _max(peaks, k, v, t):
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _up(peaks, k, v, t):
     """Running maximum of a quantity sampled at every accepted step. A local maximum at
     the previous step is refined by the parabola through the last three samples, so a
@@ -72,7 +72,7 @@ def _up(peaks, k, v, t):
     peaks[k, 5] = t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _down(peaks, k, v, t):
     """Running minimum, refined like _up (the history holds -v)."""
     peaks[k, 0] = -peaks[k, 0]
@@ -80,7 +80,7 @@ def _down(peaks, k, v, t):
     peaks[k, 0] = -peaks[k, 0]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
     """e_ref, r_ref: energy balance and residual at t = 0."""
     nw = peaks.shape[0] - PK_WHEEL_FY
@@ -108,7 +108,7 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
         peaks[PK_FIRST_CORNER, 1] = t
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def hermite_second_order(y0, f0, y1, f1, h, theta, nq, out):
     """State at t0 + theta h from (q, qd, qdd) at both ends of a step of a second-order
     system stored as y = (q, qd, extra): quintic Hermite for q, its derivative for qd,

@@ -18,7 +18,7 @@ FAC_MIN = 0.2
 FAC_MAX = 10.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _combine(y, h, w, K, m, out):
     """out = y + h * sum_j<m w_j K_j (zero weights skipped; inner loop over the state)."""
     out[:] = y
@@ -30,7 +30,7 @@ def _combine(y, h, w, K, m, out):
                 out[k] += c * Kj[k]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
@@ -59,7 +59,7 @@ def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     return abs(h) * math.sqrt(s5 / n)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_min, max_steps,
               par, arms, ends, seg, corners, nbr, ref, work, out_y, out_d, peaks, stats):
     ny = y0.shape[0]
