@@ -76,3 +76,16 @@ def test_cli_run_writes_netcdf(tmp_path):
     assert ds.sizes["time"] == 701
     for v in ("chassis_ay", "wheel_force_y", "link_tension", "pin_x", "energy_balance", "energy_residual"):
         assert "units" in ds[v].attrs
+
+
+def test_cli_run_never_overwrites_and_marks_failures(tmp_path):
+    run = [sys.executable, "-m", "trackbench.cli", "run", "--duration", "0.01", "--out", str(tmp_path)]
+    assert subprocess.run(run, capture_output=True, text=True).returncode == 0
+    first = (tmp_path / "paper_step.nc").stat().st_mtime_ns
+    r = subprocess.run(run + ["--set", "speed=12"], capture_output=True, text=True)
+    assert r.returncode == 2 and "--force" in r.stderr
+    assert (tmp_path / "paper_step.nc").stat().st_mtime_ns == first
+    # a run that fails is kept for diagnosis under a name that says so, exit code 1
+    r = subprocess.run(run + ["--name", "short", "--set", "max_steps=5"], capture_output=True, text=True)
+    assert r.returncode == 1 and "failed" in r.stdout
+    assert (tmp_path / "short.failed.nc").exists() and not (tmp_path / "short.nc").exists()

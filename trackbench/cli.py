@@ -22,15 +22,18 @@ def run(
     duration: Optional[float] = typer.Option(None, help="Simulated time (s); default: the scenario's (0.5 s)."),
     out: Path = typer.Option(Path("out"), "--out", "-o", help="Folder for the netCDF file."),
     name: str = typer.Option("paper_step", help="Scenario name, used for the file name."),
+    force: bool = typer.Option(False, "--force", help="Replace OUT/NAME.nc (and .rrd) if they exist."),
 ):
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
     from .runner import run_one
     from .scenario import ScenarioError
     try:
-        text = run_one(set_, duration, out, name)
+        text, ok = run_one(set_, duration, out, name, force)
     except ScenarioError as e:
         _fail(str(e))
     typer.echo(text)
+    if not ok:
+        raise typer.Exit(1)
 
 
 @app.command()

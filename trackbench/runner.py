@@ -27,6 +27,10 @@ def scenario_from_sets(sets, duration=None):
     return Scenario.from_dict(overrides)
 
 
+def _time(t, digits):
+    return "none" if t != t else f"{t:.{digits}f} s"
+
+
 def format_summary(ds, path=None):
     s = summary_numbers(ds)
     lines = [f"trackbench run '{ds.attrs['title'].split(': ', 1)[-1]}': {ds.attrs['status']}"
@@ -39,7 +43,7 @@ def format_summary(ds, path=None):
         f"  peak link tension         {s['peak_link_tension_kN']:10.1f} kN",
         f"  chassis vertical accel    {s['min_chassis_ay']:+.2f} .. {s['peak_chassis_ay']:+.2f} m/s^2",
         f"  min chassis speed         {s['min_chassis_vx']:.4f} m/s",
-        f"  first obstacle contact    {s['first_contact_time']:.5f} s; first link compression {s['first_compression_time']:.4f} s",
+        f"  first obstacle contact    {_time(s['first_contact_time'], 5)}; first link compression {_time(s['first_compression_time'], 4)}",
         f"  energy balance error      {100 * s['max_energy_balance_error']:.4f} % (paper: < 0.06 %); work residual {s['max_energy_residual']:.2e}",
         f"  steps {ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected), wall time {ds.attrs['wall_time']:.3f} s",
         "  note: peaks after the first compression are sensitive to tiny changes (chaotic motion); compare them as ranges.",
@@ -49,15 +53,27 @@ def format_summary(ds, path=None):
     return "\n".join(lines)
 
 
-def run_one(sets, duration, out, name):
+def run_one(sets, duration, out, name, force=False):
+    """Run, write OUT/NAME.nc (+ NAME.rrd); a failed run is kept for diagnosis as
+    NAME.failed.nc, never under the name of a complete result. Existing files of that
+    name are only replaced with force. Returns (text, ok)."""
+    from .replay.record import maybe_write_recording
     from .simulate import simulate
     sc = scenario_from_sets(sets, duration)
     sc = sc.with_overrides({"name": name})
+    targets = [Path(out) / f"{name}{ext}" for ext in (".nc", ".rrd", ".failed.nc")]
+    existing = [p for p in targets if p.exists()]
+    if existing and not force:
+        raise ScenarioError(f"{existing[0]} exists: choose another --name or --out, or --force to replace it")
     ds = simulate(sc)
-    path = write_netcdf(ds, Path(out) / f"{name}.nc")
-    from .replay.record import maybe_write_recording
-    maybe_write_recording(ds, Path(out), name=f"{name}.rrd")
-    return format_summary(ds, path)
+    ok = ds.attrs["status"] == "completed"
+    path = write_netcdf(ds, targets[0] if ok else targets[2])
+    for stale in existing:
+        if stale != path:
+            stale.unlink(missing_ok=True)
+    if ok:
+        maybe_write_recording(ds, Path(out), name=f"{name}.rrd")
+    return format_summary(ds, path), ok
 
 
 def parameter_table():
