@@ -67,7 +67,6 @@ D_CHASSIS_AX = 11        # chassis mass-centre acceleration (m/s^2)
 D_CHASSIS_AY = 12
 D_MIN_TENSION = 13
 D_MAX_TENSION = 14
-D_REBUILDS = 15          # neighbour-list rebuilds (cumulative, kept by the caller)
 D_WHEEL = 16             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 

@@ -15,12 +15,6 @@ class Ground:
     segments: np.ndarray   # (n-1, 7): x0, y0, tx, ty, length, nx, ny
     corners: np.ndarray    # (m, 2) convex corners
 
-    @property
-    def obstacle_start(self):
-        """x of the first vertex that is not on the base line y = 0 (inf if flat)."""
-        off = np.nonzero(np.abs(self.vertices[:, 1]) > 0.0)[0]
-        return float(self.vertices[off[0] - 1, 0]) if off.size else np.inf
-
 
 def ground_from_points(points):
     """Build a Ground from interior points; extends the ends horizontally to +-FAR."""
