@@ -3,9 +3,9 @@
 numba's own cache checks only the source file of each compiled function, not the files
 of the functions it calls and inlines: after an upgrade (or a `git pull` on an editable
 install) that changed only `model/kernels.py`, the cached time loop would still hold the
-old contact kernels. So the cache lives in a folder named by a hash of the whole package
-source (~/.cache/trackbench/numba/<hash>); the last few folders are kept. Setting
-NUMBA_CACHE_DIR yourself overrides this.
+old contact kernels. So the cache lives in a folder named by a hash of the source of the
+compiled code (model/, solvers/, results.py): ~/.cache/trackbench/numba/<hash>; the last
+few folders are kept. Setting NUMBA_CACHE_DIR yourself overrides this.
 """
 
 import hashlib
@@ -14,6 +14,8 @@ import shutil
 from pathlib import Path
 
 KEEP = 3
+COMPILED = ("model", "solvers")     # every @njit function lives here
+CONSTANTS = ("results.py",)          # module constants the kernels compile in
 
 
 def configure():
@@ -21,7 +23,8 @@ def configure():
         return
     root = Path(__file__).parent
     digest = hashlib.sha1()
-    for path in sorted(root.rglob("*.py")):
+    compiled = [p for sub in COMPILED for p in (root / sub).rglob("*.py")] + [root / f for f in CONSTANTS]
+    for path in sorted(compiled):
         digest.update(path.relative_to(root).as_posix().encode())
         digest.update(path.read_bytes())
     base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "trackbench" / "numba"
