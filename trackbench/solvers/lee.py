@@ -4,9 +4,10 @@ returns the reduced layout so every output means the same as for the reduced sol
 solver-specific figures go to RunResult.extra (results_schema.md, lee section)."""
 
 import numpy as np
-import xarray as xr
 
 from ..model.absolute import inverse_mass
+from ..model.layout import S_N_OUT
+from ..output import _var
 from .base import allocate_outputs, trimmed
 from .lee_loop import (L_BUILDS, L_EPS1, L_IT_ACC, L_IT_OUT, L_IT_POS, L_IT_VEL, L_PASSES, L_RATIO_ACC, L_RATIO_POS,
                        L_RATIO_VEL, L_REJ_CONSTRAINT, L_REJ_ERROR, N_L, N_X, X_ERR_ACC, X_ERR_POS, X_ERR_VEL,
@@ -36,10 +37,6 @@ _PER_SAMPLE = [  # (name, column, units, long_name)
 ]
 
 
-def _v(dims, data, units, long_name):
-    return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name})
-
-
 def run(scenario, model, y0):
     A, b, bp, c, eb, ebp, expo = RKN64.arrays()
     out_y, out_d, peaks, stats = allocate_outputs(scenario, model, y0.size)
@@ -56,12 +53,12 @@ def run(scenario, model, y0):
                   scenario["lee.max_iterations"], scenario["lee.matrix_update_angle"], minv,
                   model.par, model.arms, model.ends, model.seg, model.corners, model.nbr, model.ref,
                   model.work, out_y, out_d, out_x, out_lam, peaks, stats, lstats)
-    n = int(stats[5])  # S_N_OUT
+    n = int(stats[S_N_OUT])
     T, W = ("time",), ("time", "wheel")
-    extra = {name: _v(T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
-    extra["joint_force_x"] = _v(W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
+    extra = {name: _var(T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
+    extra["joint_force_x"] = _var(W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
-    extra["joint_force_y"] = _v(W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
+    extra["joint_force_y"] = _var(W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
     totals = [
         ("lee_total_iterations_position", L_IT_POS, "1", "lambda iterations at the position level, whole run "
@@ -82,6 +79,6 @@ def run(scenario, model, y0):
                                                                "/ tolerance"),
     ]
     for name, k, units, text in totals:
-        extra[name] = _v((), lstats[k], units, text)
-    extra["lee_accel_order"] = _v((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
+        extra[name] = _var((), lstats[k], units, text)
+    extra["lee_accel_order"] = _var((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
     return trimmed(scenario, out_y, out_d, peaks, stats, extra)
