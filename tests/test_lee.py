@@ -126,14 +126,10 @@ def test_early_trajectory_agrees_at_tight_tolerance():
     assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
 
 
-@pytest.mark.xfail(strict=False, reason="at the default tolerance the 1e-6 m bar up to 0.25 s is below the "
-                   "reduced solver's own tolerance-to-tolerance change there (chaotic growth after 0.1 s); "
-                   "it holds at tolerance 1e-11 (test above) and up to 0.15 s (test below). Old figures at 1e-8: "
-                   "7.4e-6 m / "
-                   "1.6e-5 rad by t = 0.25 s; the reduced solver alone moves by 8.5e-6 m / 1.8e-5 rad between "
-                   "tolerance 1e-8 and 1e-11 there (chaotic growth after 0.1 s), while lee at 1e-8 is 2.2e-6 m / "
-                   "2.0e-6 rad from reduced at 1e-11: the 1e-6 bar is below the reference's own error at this "
-                   "tolerance; at 1e-11 (test above) and up to 0.15 s (test below) the bar holds")
+@pytest.mark.xfail(strict=False, reason="at the default tolerance (1e-9) the 1e-6 m bar up to 0.25 s is below the "
+                   "reduced solver's own error there: it moves 8.4e-6 m between tolerances 1e-9 and 1e-11 (chaotic "
+                   "growth after 0.1 s), lee at 1e-9 is 2.8e-7 m from reduced at 1e-11; the bar holds at tolerance "
+                   "1e-11 (test above) and up to 0.15 s (test below); the test prints the figures")
 def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short):
     d = _early_diff(lee_short, paper_run_short)
     print("lee vs reduced at the default tolerance:", d)
