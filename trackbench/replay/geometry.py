@@ -26,6 +26,7 @@ HULL_BOTTOM = -0.3     # m below the mass centre (chassis frame)
 HULL_TOP = 0.6         # m above the mass centre
 FORCE_SCALE = 1.0 / 200e3  # m per N: 1 m per 200 kN
 GROUND_MARGIN = 1.0    # m of ground drawn beyond the region the track covers
+_BLOCK = 8192          # elements per block in the blocked helpers: temporaries stay small and cached
 
 # link tension colour scale: (tension in N, RGB)
 TENSION_STOPS = np.array([-100e3, 0.0, 80e3, 160e3, 300e3])
@@ -67,10 +68,23 @@ _RGBA_LUT = _lut()
 
 def tension_rgba32(tension):
     """Link tension (N) -> packed 0xRRGGBBAA uint32, as rerun stores colours (lookup table,
-    250 N resolution)."""
-    k = np.rint((np.asarray(tension, dtype=np.float64) - TENSION_STOPS[0]) * (1.0 / _LUT_STEP))
-    np.clip(k, 0, len(_RGBA_LUT) - 1, out=k)
-    return _RGBA_LUT[k.astype(np.intp)]
+    250 N resolution). Works in blocks (small temporaries, no page faults on big inputs)."""
+    t = np.asarray(tension, dtype=np.float64)
+    out = np.empty(t.shape, dtype=np.uint32)
+    flat_t = t.reshape(-1)
+    flat_o = out.reshape(-1)
+    top = len(_RGBA_LUT) - 1
+    inv = 1.0 / _LUT_STEP
+    k = np.empty(min(flat_t.size, _BLOCK))
+    for lo in range(0, flat_t.size, _BLOCK):
+        hi = min(flat_t.size, lo + _BLOCK)
+        kb = k[:hi - lo]
+        np.subtract(flat_t[lo:hi], TENSION_STOPS[0], out=kb)
+        kb *= inv
+        np.rint(kb, out=kb)
+        np.clip(kb, 0, top, out=kb)
+        np.take(_RGBA_LUT, kb.astype(np.intp), out=flat_o[lo:hi])
+    return out
 
 
 def _rotate(c, s, bx, by):
@@ -105,25 +119,98 @@ def ground_polyline(ds, x_range=None):
     return np.vstack([[at(x0)], inner.reshape(-1, 2), [at(x1)]])
 
 
+def _nearest_xy(px, py, poly):
+    """Points (px, py) (1-D) -> (distance, nearest x, nearest y) on the polyline, each (k,).
+    Works through the points in blocks with reused buffers (same arithmetic per point)."""
+    k = px.shape[0]
+    dist, nx, ny = np.empty(k), np.zeros(k), np.zeros(k)
+    segs = [(ax, ay, bx - ax, by - ay) for (ax, ay), (bx, by) in zip(poly[:-1].tolist(), poly[1:].tolist())]
+    segs = [(ax, ay, dx, dy, dx * dx + dy * dy) for ax, ay, dx, dy in segs]
+    m = min(k, _BLOCK)
+    best, u, fx, fy, d2, tmp = (np.empty(m) for _ in range(6))
+    closer = np.empty(m, dtype=bool)
+    for lo in range(0, k, _BLOCK):
+        hi = min(k, lo + _BLOCK)
+        j = hi - lo
+        bx_, by_ = px[lo:hi], py[lo:hi]
+        b, U, FX, FY, D2, TMP, C = best[:j], u[:j], fx[:j], fy[:j], d2[:j], tmp[:j], closer[:j]
+        NX, NY = nx[lo:hi], ny[lo:hi]
+        b.fill(np.inf)
+        for ax, ay, dx, dy, l2 in segs:   # a handful of segments
+            if l2 == 0.0:
+                continue
+            # u = clip(((px - ax) * dx + (py - ay) * dy) / l2, 0, 1)
+            np.subtract(bx_, ax, out=U)
+            U *= dx
+            np.subtract(by_, ay, out=TMP)
+            TMP *= dy
+            U += TMP
+            U /= l2
+            np.clip(U, 0.0, 1.0, out=U)
+            np.multiply(U, dx, out=FX)
+            FX += ax
+            np.multiply(U, dy, out=FY)
+            FY += ay
+            # d2 = (px - fx) ** 2 + (py - fy) ** 2
+            np.subtract(bx_, FX, out=D2)
+            np.square(D2, out=D2)
+            np.subtract(by_, FY, out=TMP)
+            np.square(TMP, out=TMP)
+            D2 += TMP
+            np.less(D2, b, out=C)
+            np.copyto(b, D2, where=C)
+            np.copyto(NX, FX, where=C)
+            np.copyto(NY, FY, where=C)
+        np.sqrt(b, out=dist[lo:hi])
+    return dist, nx, ny
+
+
 def _nearest_on_polyline(p, poly):
     """p (..., 2) -> (distance (...), nearest point (..., 2)) to the polyline."""
-    px, py = p[..., 0], p[..., 1]
-    best = np.full(px.shape, np.inf)
-    nx = np.zeros(px.shape)
-    ny = np.zeros(px.shape)
-    for (ax, ay), (bx, by) in zip(poly[:-1], poly[1:]):   # a handful of segments
-        dx, dy = bx - ax, by - ay
-        l2 = dx * dx + dy * dy
-        if l2 == 0.0:
-            continue
-        u = np.clip(((px - ax) * dx + (py - ay) * dy) / l2, 0.0, 1.0)
-        fx, fy = ax + u * dx, ay + u * dy
-        d2 = (px - fx) ** 2 + (py - fy) ** 2
-        closer = d2 < best
-        best = np.where(closer, d2, best)
-        nx = np.where(closer, fx, nx)
-        ny = np.where(closer, fy, ny)
-    return np.sqrt(best), np.stack([nx, ny], axis=-1)
+    p = np.asarray(p, dtype=float)
+    shape = p.shape[:-1]
+    dist, nx, ny = _nearest_xy(p[..., 0].reshape(-1), p[..., 1].reshape(-1), poly)
+    return dist.reshape(shape), np.stack([nx, ny], axis=-1).reshape(shape + (2,))
+
+
+def ground_arrow_centre(free_x, free_y, poly, hg):
+    """Centre of the ground-force arrow per frame (n, 2): the pad-compression-weighted mean
+    of the nearest ground points of the free pins (free_x, free_y, each (n, k)) that touch
+    the ground (`poly` the ground polyline, `hg` the pad thickness); frames with no pin
+    touching use the ground point under the lowest pin."""
+    n, k = free_y.shape
+    # only pins below the highest ground point + h_g can touch: compute those alone
+    low = free_y < float(poly[:, 1].max()) + hg
+    flat = np.flatnonzero(low)
+    fi = flat // k if k else flat
+    pi = flat - fi * k
+    sel_x, sel_y = free_x[fi, pi], free_y[fi, pi]
+    dist, near_x, near_y = _nearest_xy(sel_x, sel_y, poly)
+    w = np.maximum(hg - dist, 0.0)
+    wsum = np.bincount(fi, weights=w, minlength=n)
+    cx = np.bincount(fi, weights=w * near_x, minlength=n)
+    cy = np.bincount(fi, weights=w * near_y, minlength=n)
+    touching = wsum > 0.0
+    safe = np.where(touching, wsum, 1.0)
+    centre = np.stack([cx / safe, cy / safe], axis=-1)
+    # no pin touching (the track airborne, or only on a corner): the arrow (then about zero)
+    # sits below the track's lowest pin, on the ground (computed for those frames only)
+    rows = np.flatnonzero(~touching)
+    if len(rows):
+        lowest = np.argmin(free_y[rows], axis=1)
+        _, ux, uy = _nearest_xy(free_x[rows, lowest], free_y[rows, lowest], poly)
+        centre[rows, 0] = ux
+        centre[rows, 1] = uy
+    return centre
+
+
+def hull_body(ds):
+    """The chassis outline in the chassis frame: (bx, by), 5 corners each (closed)."""
+    ends = np.asarray(attr_json(ds, "track_ends"), float)
+    front, rear = float(np.max(ends[:, 0])), float(np.min(ends[:, 0]))
+    bx = np.array([rear - HULL_MARGIN, front + HULL_MARGIN, front + HULL_MARGIN, rear - HULL_MARGIN, rear - HULL_MARGIN])
+    by = np.array([HULL_BOTTOM, HULL_BOTTOM, HULL_TOP, HULL_TOP, HULL_BOTTOM])
+    return bx, by
 
 
 def side_view(ds, idx=None):
@@ -145,10 +232,7 @@ def side_view(ds, idx=None):
 
     x, y, th = take("chassis_x"), take("chassis_y"), take("chassis_pitch")
     c, s = np.cos(th), np.sin(th)
-    ends = np.asarray(attr_json(ds, "track_ends"), float)
-    front, rear = float(np.max(ends[:, 0])), float(np.min(ends[:, 0]))
-    bx = np.array([rear - HULL_MARGIN, front + HULL_MARGIN, front + HULL_MARGIN, rear - HULL_MARGIN, rear - HULL_MARGIN])
-    by = np.array([HULL_BOTTOM, HULL_BOTTOM, HULL_TOP, HULL_TOP, HULL_BOTTOM])
+    bx, by = hull_body(ds)
     hx, hy = _rotate(c, s, bx, by)
     chassis = np.stack([x[:, None] + hx, y[:, None] + hy], axis=-1)
     piv = np.asarray(attr_json(ds, "arm_pivots"), float)
@@ -172,26 +256,7 @@ def side_view(ds, idx=None):
         "wheel_arrow_vector": FORCE_SCALE * f,
     }
     # ground force at the pad-compression-weighted centre of the free pins' ground contacts
-    hg = float(ds.attrs["pad_ground"])
-    free = pins[:, 1:-1]
-    poly = ground_polyline(ds)
-    # only pins below the highest ground point + h_g can touch: compute those alone
-    low = free[..., 1] < float(poly[:, 1].max()) + hg
-    fi, pi = np.nonzero(low)
-    dist, near = _nearest_on_polyline(free[fi, pi], poly)
-    w = np.maximum(hg - dist, 0.0)
-    n = len(idx)
-    wsum = np.bincount(fi, weights=w, minlength=n)
-    cx = np.bincount(fi, weights=w * near[:, 0], minlength=n)
-    cy = np.bincount(fi, weights=w * near[:, 1], minlength=n)
-    touching = wsum > 0.0
-    safe = np.where(touching, wsum, 1.0)
-    centre = np.stack([cx / safe, cy / safe], axis=-1)
-    # no pin touching (the track airborne, or only on a corner): the arrow (then about zero)
-    # sits below the track's lowest pin, on the ground
-    lowest = np.argmin(free[..., 1], axis=1)
-    _, under = _nearest_on_polyline(free[np.arange(n), lowest], poly)
-    centre = np.where(touching[:, None], centre, under)
+    centre = ground_arrow_centre(pins[:, 1:-1, 0], pins[:, 1:-1, 1], ground_polyline(ds), float(ds.attrs["pad_ground"]))
     g = np.stack([take("ground_force_x"), take("ground_force_y")], axis=-1) * FORCE_SCALE
     out["ground_arrow_origin"] = centre - g
     out["ground_arrow_vector"] = g

@@ -14,6 +14,7 @@ the vehicle upright; hovering shows -y. The time series under /signals are plain
 equal to the Dataset's.
 """
 
+import functools
 import json
 import os
 import tempfile
@@ -62,6 +63,10 @@ GROUND_FORCE_RGB = (150, 60, 200)
 
 
 _STRIP_TYPE = LineStrip2DBatch._ARROW_DATATYPE
+_VEC2_TYPE = rr.components.Position2DBatch._ARROW_DATATYPE   # fixed_size_list<float32 not null>[2]
+_COLOR_TYPE = rr.components.ColorBatch._ARROW_DATATYPE       # uint32 0xRRGGBBAA
+_SCALAR_TYPE = rr.components.ScalarBatch._ARROW_DATATYPE     # float64
+_FRAME_BLOCK = 2048  # frames per block when working out the side view (keeps temporaries small)
 
 
 def wheel_rgb(i):
@@ -91,14 +96,52 @@ def _flip(a):
     return a
 
 
-def _strips(a):
-    """(n_strips, m, 2) array -> the Arrow list array rerun's LineStrip2D component stores
-    (built directly: rerun's own converter loops over the strips in Python). y is negated."""
-    a = _flip(a)
-    n, m = a.shape[0], a.shape[1]
-    vals = pa.FixedSizeListArray.from_arrays(pa.array(a.reshape(-1)), type=_STRIP_TYPE.value_type)
-    offsets = pa.array(np.arange(0, n * m + 1, m, dtype=np.int32))
-    return pa.ListArray.from_arrays(offsets, vals, type=_STRIP_TYPE)
+def _xy32(x, y, out=None):
+    """x, y (float64, same shape) -> float32 (..., 2) with y negated (as _flip of the stacked
+    pair: both round to float32 first; negation is exact)."""
+    if out is None:
+        out = np.empty(np.shape(x) + (2,), dtype=np.float32)
+    out[..., 0] = x
+    np.negative(y, out=out[..., 1], casting="same_kind")
+    return out
+
+
+def _offsets(count, step):
+    return np.arange(0, count * step + 1, step, dtype=np.int32)
+
+
+def _list(values, rows, per_row):
+    """Arrow list array: `rows` rows of `per_row` items each of the Arrow array `values`."""
+    return pa.ListArray.from_arrays(pa.array(_offsets(rows, per_row)), values)
+
+
+def _vec2(a32):
+    """float32 (..., 2) -> Arrow fixed_size_list<float32>[2] values (zero copy)."""
+    return pa.FixedSizeListArray.from_arrays(pa.array(a32.reshape(-1)), type=_VEC2_TYPE)
+
+
+def _strip_values(a32):
+    """float32 (n_strips, m, 2) -> Arrow LineStrip2D values (list of m points per strip)."""
+    n, m = a32.shape[0], a32.shape[1]
+    return pa.ListArray.from_arrays(pa.array(_offsets(n, m)), _vec2(a32), type=_STRIP_TYPE)
+
+
+class _Column:
+    """A ready-made component column for `send_columns`: its descriptor and its Arrow list
+    array (one list per row). Built straight from numpy; rerun's archetype `.columns()` /
+    `.partition()` would copy and re-validate the same data."""
+
+    __slots__ = ("descriptor", "array")
+
+    def __init__(self, descriptor, array):
+        self.descriptor = descriptor
+        self.array = array
+
+    def component_descriptor(self):
+        return self.descriptor
+
+    def as_arrow_array(self):
+        return self.array
 
 
 def _md_table(rows):
@@ -152,7 +195,7 @@ def blueprint(ds):
     """Side view large on the left; wheel forces, chassis acceleration and velocity on the
     right; energies, link tension and the text documents in tabs below them."""
     x0, x1 = G.covered_x_range(ds)
-    ground = G.ground_polyline(ds)
+    ground = G.ground_polyline(ds, (x0, x1))
     top = float(np.nanmax(ds.variables["chassis_y"].values)) + G.HULL_TOP + 0.5
     bottom = float(np.min(ground[:, 1])) - 0.5
     side = rrb.Spatial2DView(origin="/world", name="side view (x forward; up is up)",
@@ -173,28 +216,37 @@ def blueprint(ds):
                          rrb.TimePanel(state="expanded", timeline=TIMELINE, playback_speed=PLAYBACK_SPEED))
 
 
+@functools.lru_cache(maxsize=16)
+def _static_styles(nw, r):
+    """The static archetypes that depend only on the wheel count and radius (built once per
+    process: rerun's archetype constructors are slow next to logging them): entity -> archetype."""
+    return {
+        E_CHASSIS: rr.LineStrips2D.from_fields(colors=[CHASSIS_RGB], radii=[0.02]),
+        E_ARMS: rr.LineStrips2D.from_fields(colors=[ARM_RGB], radii=[0.03]),
+        E_WHEELS: rr.Ellipses2D.from_fields(half_sizes=[[r, r]] * nw, colors=[wheel_rgb(i) for i in range(nw)],
+                                            line_radii=[0.012], labels=[f"wheel {i + 1}" for i in range(nw)]),
+        E_LINKS: rr.LineStrips2D.from_fields(radii=[0.012]),
+        E_PINS: rr.Points2D.from_fields(radii=[0.02], colors=[(30, 30, 30)]),
+        E_WHEEL_FORCE: rr.Arrows2D.from_fields(colors=[WHEEL_FORCE_RGB], radii=[0.015]),
+        E_GROUND_FORCE: rr.Arrows2D.from_fields(colors=[GROUND_FORCE_RGB], radii=[0.02],
+                                                labels=["ground force (total)"]),
+        E_WHEEL_FY: rr.SeriesLines(colors=[wheel_rgb(i) for i in range(nw)],
+                                   names=[f"wheel {i + 1}" for i in range(nw)]),
+        E_AY: rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis a_y (m/s^2)"]),
+        E_VX: rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis v_x (m/s)"]),
+        E_ENERGY: rr.SeriesLines(colors=[rgb for _, _, rgb in ENERGY_SERIES],
+                                 names=[name for name, _, _ in ENERGY_SERIES]),
+        E_TENSION: rr.SeriesLines(colors=[(200, 0, 0)], names=["max link tension (N)"]),
+    }
+
+
 def _log_static(rec, ds):
-    nw = ds.sizes["wheel"]
-    r = float(ds.attrs["wheel_radius"])
+    styles = _static_styles(int(ds.sizes["wheel"]), float(ds.attrs["wheel_radius"]))
     rec.log(E_GROUND, rr.LineStrips2D([_flip(G.ground_polyline(ds))], colors=[GROUND_RGB], radii=[0.015],
                                       labels=["ground"]), static=True)
-    rec.log(E_CHASSIS, rr.LineStrips2D.from_fields(colors=[CHASSIS_RGB], radii=[0.02]), static=True)
-    rec.log(E_ARMS, rr.LineStrips2D.from_fields(colors=[ARM_RGB], radii=[0.03]), static=True)
-    rec.log(E_WHEELS, rr.Ellipses2D.from_fields(half_sizes=[[r, r]] * nw, colors=[wheel_rgb(i) for i in range(nw)],
-                                                line_radii=[0.012], labels=[f"wheel {i + 1}" for i in range(nw)]),
-            static=True)
-    rec.log(E_LINKS, rr.LineStrips2D.from_fields(radii=[0.012]), static=True)
-    rec.log(E_PINS, rr.Points2D.from_fields(radii=[0.02], colors=[(30, 30, 30)]), static=True)
-    rec.log(E_WHEEL_FORCE, rr.Arrows2D.from_fields(colors=[WHEEL_FORCE_RGB], radii=[0.015]), static=True)
-    rec.log(E_GROUND_FORCE, rr.Arrows2D.from_fields(colors=[GROUND_FORCE_RGB], radii=[0.02],
-                                                    labels=["ground force (total)"]), static=True)
-    rec.log(E_WHEEL_FY, rr.SeriesLines(colors=[wheel_rgb(i) for i in range(nw)],
-                                       names=[f"wheel {i + 1}" for i in range(nw)]), static=True)
-    rec.log(E_AY, rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis a_y (m/s^2)"]), static=True)
-    rec.log(E_VX, rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis v_x (m/s)"]), static=True)
-    rec.log(E_ENERGY, rr.SeriesLines(colors=[rgb for _, _, rgb in ENERGY_SERIES],
-                                     names=[name for name, _, _ in ENERGY_SERIES]), static=True)
-    rec.log(E_TENSION, rr.SeriesLines(colors=[(200, 0, 0)], names=["max link tension (N)"]), static=True)
+    for e in (E_CHASSIS, E_ARMS, E_WHEELS, E_LINKS, E_PINS, E_WHEEL_FORCE, E_GROUND_FORCE,
+              E_WHEEL_FY, E_AY, E_VX, E_ENERGY, E_TENSION):
+        rec.log(e, styles[e], static=True)
     rec.log(E_PARAMS, rr.TextDocument(parameters_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
     rec.log(E_SOLVER, rr.TextDocument(solver_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
 
@@ -202,51 +254,105 @@ def _log_static(rec, ds):
 def _log_signals(rec, ds):
     """Time series at every output frame (cheap; keeps the peaks). Multi-series entities
     (wheel forces, energies) hold one scalar per series per row."""
-    t = rr.TimeColumn(TIMELINE, duration=np.asarray(ds.variables["time"].values, dtype=np.float64))
-    fy = np.ascontiguousarray(ds.variables["wheel_force_y"].values, dtype=np.float64)
-    n = fy.shape[0]
-    rec.send_columns(E_WHEEL_FY, indexes=[t],
-                     columns=rr.Scalars.columns(scalars=fy.reshape(-1)).partition(np.full(n, fy.shape[1], np.int32)))
-    rec.send_columns(E_AY, indexes=[t], columns=rr.Scalars.columns(scalars=ds.variables["chassis_ay"].values))
-    rec.send_columns(E_VX, indexes=[t], columns=rr.Scalars.columns(scalars=ds.variables["chassis_vx"].values))
+    t = [rr.TimeColumn(TIMELINE, duration=np.asarray(ds.variables["time"].values, dtype=np.float64))]
+    d = rr.Scalars.descriptor_scalars()
+
+    def scalars(a):
+        a = np.ascontiguousarray(a, dtype=np.float64)
+        n, k = a.shape[0], (a.shape[1] if a.ndim == 2 else 1)
+        return [_Column(d, _list(pa.array(a.reshape(-1), type=_SCALAR_TYPE), n, k))]
+
+    rec.send_columns(E_WHEEL_FY, indexes=t, columns=scalars(ds.variables["wheel_force_y"].values))
+    rec.send_columns(E_AY, indexes=t, columns=scalars(ds.variables["chassis_ay"].values))
+    rec.send_columns(E_VX, indexes=t, columns=scalars(ds.variables["chassis_vx"].values))
     e = np.stack([ds.variables[var].values for _, var, _ in ENERGY_SERIES], axis=1)
-    rec.send_columns(E_ENERGY, indexes=[t],
-                     columns=rr.Scalars.columns(scalars=e.reshape(-1)).partition(np.full(n, e.shape[1], np.int32)))
-    rec.send_columns(E_TENSION, indexes=[t],
-                     columns=rr.Scalars.columns(scalars=np.nanmax(ds.variables["link_tension"].values, axis=1)))
+    rec.send_columns(E_ENERGY, indexes=t, columns=scalars(e))
+    rec.send_columns(E_TENSION, indexes=t, columns=scalars(np.nanmax(ds.variables["link_tension"].values, axis=1)))
 
 
 def _log_frames(rec, ds, idx):
-    g = G.side_view(ds, idx)
+    """The side view at the frames `idx`: the same geometry as geometry.side_view, computed
+    straight into float32 (y negated) buffers and Arrow arrays, one send_columns per entity.
+    The track (the bulk of the data) goes first: rerun encodes it on its own thread while
+    the rest is prepared."""
+    idx = np.asarray(idx)
     n = len(idx)
-    t = [rr.TimeColumn(TIMELINE, duration=g["time"])]
+    full = n == ds.sizes["time"] and (n == 0 or (idx[0] == 0 and idx[-1] == n - 1))
 
-    def ones(k):
-        return np.full(n, k, dtype=np.int32)
+    def take(name):
+        v = np.asarray(ds.variables[name].values)
+        return v if full else v[idx]
 
-    rec.send_columns(E_CHASSIS, indexes=t, columns=rr.LineStrips2D.columns(strips=_strips(g["chassis"])).partition(ones(1)))
-    arms = np.stack([g["pivots"], g["wheels"]], axis=2)            # (n, nw, 2, 2)
-    nw = arms.shape[1]
-    rec.send_columns(E_ARMS, indexes=t,
-                     columns=rr.LineStrips2D.columns(strips=_strips(arms.reshape(n * nw, 2, 2))).partition(ones(nw)))
-    rec.send_columns(E_WHEELS, indexes=t,
-                     columns=rr.Ellipses2D.columns(centers=_flip(g["wheels"].reshape(-1, 2))).partition(ones(nw)))
-    pins = g["pins"]
-    nl = pins.shape[1] - 1
-    links = np.stack([pins[:, :-1], pins[:, 1:]], axis=2)          # (n, nl, 2, 2)
-    rec.send_columns(E_LINKS, indexes=t,
-                     columns=rr.LineStrips2D.columns(strips=_strips(links.reshape(n * nl, 2, 2)),
-                                                     colors=G.tension_rgba32(g["tension"]).reshape(-1))
-                     .partition(ones(nl)))
-    rec.send_columns(E_PINS, indexes=t,
-                     columns=rr.Points2D.columns(positions=_flip(pins.reshape(-1, 2))).partition(ones(nl + 1)))
-    rec.send_columns(E_WHEEL_FORCE, indexes=t,
-                     columns=rr.Arrows2D.columns(origins=_flip(g["wheel_arrow_origin"].reshape(-1, 2)),
-                                                 vectors=_flip(g["wheel_arrow_vector"].reshape(-1, 2)))
-                     .partition(ones(nw)))
-    rec.send_columns(E_GROUND_FORCE, indexes=t,
-                     columns=rr.Arrows2D.columns(origins=_flip(g["ground_arrow_origin"]),
-                                                 vectors=_flip(g["ground_arrow_vector"])).partition(ones(1)))
+    t = [rr.TimeColumn(TIMELINE, duration=take("time"))]
+    send = rec.send_columns
+
+    # track: pins, links (coloured by tension)
+    pin_x, pin_y = take("pin_x"), take("pin_y")
+    pins = _xy32(pin_x, pin_y)                                    # (n, np, 2)
+    npin = pins.shape[1]
+    nl = npin - 1
+    send(E_PINS, indexes=t, columns=[_Column(rr.Points2D.descriptor_positions(), _list(_vec2(pins), n, npin))])
+    p64 = pins.view(np.uint64)[..., 0]                           # one (x, y) float32 pair as 8 bytes
+    links64 = np.empty((n, nl, 2), dtype=np.uint64)
+    links64[:, :, 0] = p64[:, :-1]
+    links64[:, :, 1] = p64[:, 1:]
+    links = links64.view(np.float32)                              # (n, nl, 4): the link's two ends
+    colors = G.tension_rgba32(take("link_tension"))
+    send(E_LINKS, indexes=t,
+         columns=[_Column(rr.LineStrips2D.descriptor_strips(), _list(_strip_values(links.reshape(n * nl, 2, 2)), n, nl)),
+                  _Column(rr.LineStrips2D.descriptor_colors(), _list(pa.array(colors.reshape(-1), type=_COLOR_TYPE), n, nl))])
+
+    # chassis outline, arms (pivot to wheel centre), wheel-track force arrows (from the
+    # contact region along the force), ground force (total) at the pad-compression-weighted
+    # centre of the pins' ground contacts: worked out in blocks of frames, straight into the
+    # float32 output buffers (small temporaries: no page faults on megabytes of them)
+    x, y, th = take("chassis_x"), take("chassis_y"), take("chassis_pitch")
+    cos, sin = np.cos(th), np.sin(th)
+    bx, by = G.hull_body(ds)
+    piv = np.asarray(G.attr_json(ds, "arm_pivots"), float)
+    wx, wy = take("wheel_x"), take("wheel_y")
+    fx, fy = take("wheel_force_x"), take("wheel_force_y")
+    gfx, gfy = take("ground_force_x"), take("ground_force_y")
+    nw = wx.shape[1]
+    reach = float(ds.attrs["wheel_radius"]) + float(ds.attrs["pad_wheel"])
+    poly, hg = G.ground_polyline(ds), float(ds.attrs["pad_ground"])
+    chassis = np.empty((n, len(bx), 2), dtype=np.float32)
+    arms = np.empty((n, nw, 2, 2), dtype=np.float32)
+    origin = np.empty((n, nw, 2), dtype=np.float32)
+    vector = np.empty((n, nw, 2), dtype=np.float32)
+    g_origin = np.empty((n, 2), dtype=np.float32)
+    g_vector = np.empty((n, 2), dtype=np.float32)
+    for lo in range(0, n, _FRAME_BLOCK):
+        b = slice(lo, min(n, lo + _FRAME_BLOCK))
+        c, s, xb, yb = cos[b], sin[b], x[b, None], y[b, None]
+        hx, hy = G._rotate(c, s, bx, by)
+        _xy32(xb + hx, yb + hy, out=chassis[b])
+        px, py = G._rotate(c, s, piv[:, 0], piv[:, 1])
+        _xy32(xb + px, yb + py, out=arms[b, :, 0])
+        _xy32(wx[b], wy[b], out=arms[b, :, 1])
+        fxb, fyb = fx[b], fy[b]
+        mag = np.hypot(fxb, fyb)
+        pos = mag > 0.0
+        safe = np.where(pos, mag, 1.0)
+        ux = np.where(pos, fxb / safe, 0.0)
+        uy = np.where(pos, fyb / safe, 1.0)
+        _xy32(wx[b] - reach * ux, wy[b] - reach * uy, out=origin[b])
+        _xy32(G.FORCE_SCALE * fxb, G.FORCE_SCALE * fyb, out=vector[b])
+        centre = G.ground_arrow_centre(pin_x[b, 1:-1], pin_y[b, 1:-1], poly, hg)
+        gx, gy = gfx[b] * G.FORCE_SCALE, gfy[b] * G.FORCE_SCALE
+        _xy32(centre[:, 0] - gx, centre[:, 1] - gy, out=g_origin[b])
+        _xy32(gx, gy, out=g_vector[b])
+    strips = rr.LineStrips2D.descriptor_strips()
+    send(E_CHASSIS, indexes=t, columns=[_Column(strips, _list(_strip_values(chassis), n, 1))])
+    send(E_ARMS, indexes=t, columns=[_Column(strips, _list(_strip_values(arms.reshape(n * nw, 2, 2)), n, nw))])
+    wheels = np.ascontiguousarray(arms[:, :, 1])
+    send(E_WHEELS, indexes=t, columns=[_Column(rr.Ellipses2D.descriptor_centers(), _list(_vec2(wheels), n, nw))])
+    send(E_WHEEL_FORCE, indexes=t,
+         columns=[_Column(rr.Arrows2D.descriptor_origins(), _list(_vec2(origin), n, nw)),
+                  _Column(rr.Arrows2D.descriptor_vectors(), _list(_vec2(vector), n, nw))])
+    send(E_GROUND_FORCE, indexes=t,
+         columns=[_Column(rr.Arrows2D.descriptor_origins(), _list(_vec2(g_origin), n, 1)),
+                  _Column(rr.Arrows2D.descriptor_vectors(), _list(_vec2(g_vector), n, 1))])
 
 
 def write_recording(ds, path, every=1):
@@ -267,9 +373,10 @@ def write_recording(ds, path, every=1):
     try:
         rec.save(tmp, default_blueprint=blueprint(ds))
         rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
-        # the bulky per-frame geometry first: rerun encodes it on its own thread meanwhile
-        _log_frames(rec, ds, idx)
+        # rerun encodes what was sent on its own thread while the next entity is prepared:
+        # the time series first (nothing to prepare), then the geometry
         _log_signals(rec, ds)
+        _log_frames(rec, ds, idx)
         _log_static(rec, ds)
         rec.flush()
         rec.disconnect()
