@@ -128,6 +128,10 @@ def run_local(tasks, workers=2):
     """Yield (task, record) as runs finish, on a spawn-context process pool."""
     import multiprocessing
     ctx = multiprocessing.get_context("spawn")
+    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
+    # threads spin (seen at ~6 % of a core per worker); spawned children inherit this
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
     with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm) as pool:
         futures = {pool.submit(execute_run, t): t for t in tasks}
         try:
