@@ -126,11 +126,9 @@ def test_early_trajectory_agrees_at_tight_tolerance():
     assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
 
 
-@pytest.mark.xfail(strict=False, reason="at the default tolerance (1e-9) the 1e-6 m bar up to 0.25 s is below the "
-                   "reduced solver's own error there: it moves 8.4e-6 m between tolerances 1e-9 and 1e-11 (chaotic "
-                   "growth after 0.1 s), lee at 1e-9 is 2.8e-7 m from reduced at 1e-11; the bar holds at tolerance "
-                   "1e-11 (test above) and up to 0.15 s (test below); the test prints the figures")
 def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short):
+    """Chassis y and pitch within 1e-6 up to 0.25 s at the default tolerance (measured
+    4.3e-7 m / 1.8e-7 rad; the reduced solver locates contact onsets, solvers/events.py)."""
     d = _early_diff(lee_short, paper_run_short)
     print("lee vs reduced at the default tolerance:", d)
     assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
@@ -148,7 +146,7 @@ def _out_of_range(lee_run, reduced_runs):
     mine = summary_numbers(lee_run)
     bad = {}
     for k, v in mine.items():
-        if k in ("status", "steps", "wall_time"):
+        if k in ("status", "steps", "wall_time") or k in EARLY_QUANTITIES:
             continue
         vals = [r[k] for r in red]
         lo, hi = min(vals), max(vals)
@@ -157,6 +155,10 @@ def _out_of_range(lee_run, reduced_runs):
             bad[k] = (v, lo - w / 2, hi + w / 2)
     return bad
 
+
+# quantities settled before 0.25 s: compared sharply in test_early_events_agree, not as
+# late ranges (the issue: "after 0.25 s, every summary quantity ...")
+EARLY_QUANTITIES = ("first_contact_time", "first_compression_time", "peak_wheel1_force_y_kN", "peak_wheel2_force_y_kN")
 
 # the quantities the spec names as chaotic-sensitive (late wheel 3-5 peaks, acceleration
 # extremes after 0.25 s, peak link tension): compared only in the non-strict xfail below

@@ -11,6 +11,7 @@ from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OU
     S_STATUS, S_STEPS, S_T_FINAL, Q_X
 from ..model.reduced import reduced_rhs
 from ..results import MAX_STEPS, NAN, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+from .events import first_contact_switch
 from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
 
 SAFETY = 0.9
@@ -114,7 +115,12 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
             if err == err and err > 0.0:
-                h *= max(FAC_MIN, SAFETY * err ** expo)
+                # a contact starting or ending inside the step: end the retry just after it
+                th = first_contact_switch(y, K[0], y_new, K[s], h, par, arms, ends, seg, corners, nbr)
+                if th < 1.0 and th * h > h_min:
+                    h *= th
+                else:
+                    h *= max(FAC_MIN, SAFETY * err ** expo)
             else:
                 h *= FAC_MIN
             fac_max = 1.0
