@@ -72,6 +72,10 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     ys = np.empty(ny)
     fs = np.empty(ny)
     er5 = np.empty(ny)
+    pins0 = np.empty((work[0].shape[0], 2))  # scratch of the event location
+    pins1 = np.empty_like(pins0)
+    wheels0 = np.empty((arms.shape[0], 2))
+    wheels1 = np.empty_like(wheels0)
     er3 = np.empty(ny)
     diag = np.empty(out_d.shape[1])
     n_rhs = 0
@@ -116,7 +120,8 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
             rejected += 1
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
-                th = first_contact_switch(y, K[0], y_new, K[s], h, par, arms, ends, seg, corners, nbr)
+                th = first_contact_switch(y, K[0], y_new, K[s], h, par, arms, ends, seg, corners, nbr,
+                                          pins0, pins1, wheels0, wheels1)
                 if th < 1.0 and th * h > h_min:
                     h *= th
                 else:
