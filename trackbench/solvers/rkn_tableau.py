@@ -24,6 +24,8 @@ from math import factorial, sqrt
 
 import numpy as np
 
+from .tableau import lower_triangular
+
 R = sqrt(8581.0)
 
 _C = [0.0, (209.0 - R) / 900.0, (209.0 - R) / 450.0, (209.0 + R) / 450.0, 0.9, 1.0]
@@ -110,11 +112,7 @@ class NystromPair:
 
     def arrays(self):
         """(A, b, bp, c, eb, ebp, step-size exponent) as float arrays."""
-        s = self.stages
-        A = np.zeros((s, s))
-        for i, row in enumerate(self.a):
-            A[i, :i] = row
-        return (A, np.array(self.b), np.array(self.bp), np.array(self.c), np.array(self.eb),
+        return (lower_triangular(self.a), np.array(self.b), np.array(self.bp), np.array(self.c), np.array(self.eb),
                 np.array(self.ebp), -1.0 / (self.error_order + 1))
 
 

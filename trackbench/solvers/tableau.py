@@ -12,6 +12,14 @@ import numpy as np
 from . import coefficients as K
 
 
+def lower_triangular(rows):
+    """The strictly lower-triangular rows of a tableau as a square float matrix."""
+    A = np.zeros((len(rows), len(rows)))
+    for i, row in enumerate(rows):
+        A[i, :i] = row
+    return A
+
+
 @dataclass(frozen=True)
 class ButcherTableau:
     name: str
@@ -42,12 +50,8 @@ class ButcherTableau:
 
     def arrays(self):
         """(A, b, c, e, e3, error exponent) as float arrays for the compiled stepper."""
-        s = self.stages
-        A = np.zeros((s, s))
-        for i, row in enumerate(self.a):
-            A[i, :i] = row
-        e3 = np.array(self.e3 if self.e3 else np.zeros(s + 1))
-        return A, np.array(self.b), np.array(self.c), np.array(self.e), e3, -1.0 / (self.error_order + 1)
+        e3 = np.array(self.e3 if self.e3 else np.zeros(self.stages + 1))
+        return lower_triangular(self.a), np.array(self.b), np.array(self.c), np.array(self.e), e3, -1.0 / (self.error_order + 1)
 
 
 DOP853 = ButcherTableau("dop853", 8, 7, tuple(K.DOP853_C), tuple(map(tuple, K.DOP853_A)),
