@@ -2,9 +2,8 @@
 iteration, Dormand-Prince RKN6(4) steps; cross-validated against the reduced solver.
 
 Runs are shared through module fixtures; every simulation is as short as its test
-needs. Targets that the current code does not meet are marked xfail(strict=True) with
-their measured figures, so they stay visible (and turn into failures if they start
-passing and the mark is stale)."""
+needs. The one bar that depends on chance (the paper's 0.06 % energy balance over the
+whole chaotic run) is a non-strict xfail that prints its figures."""
 
 import math
 
@@ -18,7 +17,11 @@ from trackbench.solvers.lee_iter import accel_matrix
 from trackbench.solvers.rkn_tableau import RKN64, NystromPair
 
 EARLY = 0.25          # s: the reproducible part of paper_step (spec)
-RED_TOLS = (1e-8, 1e-9, 1e-10, 1e-11)
+# "the range the reduced solver gives over tolerances 1e-8 to 1e-11": sampled 3 per
+# decade. The late quantities are chaotic (spec), so a range drawn from the 4 decade
+# points alone is a lottery: any rounding-level change of either solver moves a
+# quantity in or out of it (README, "Cross-validation").
+RED_TOLS = tuple(float(t) for t in np.logspace(-8, -11, 10))
 
 
 def lee(**kw):
@@ -42,7 +45,7 @@ def reduced_runs(paper_run):
     """Reduced solver, 0.5 s, at tolerances 1e-8 .. 1e-11 (the default one shared)."""
     out = {}
     for tol in RED_TOLS:
-        if tol == paper_run.attrs["tolerance"]:
+        if tol == pytest.approx(paper_run.attrs["tolerance"], rel=1e-12):
             out[tol] = paper_run
         else:
             out[tol] = tb.simulate(tb.Scenario.paper(tolerance=tol))
@@ -116,28 +119,39 @@ def test_early_events_agree(lee_short, paper_run_short):
     np.testing.assert_allclose(a.peak_wheel_force_y.values[:2], r.peak_wheel_force_y.values[:2], rtol=1e-3)
 
 
-def test_early_trajectory_agrees_at_tight_tolerance():
-    """At integration tolerance 1e-11 for both solvers: chassis y and pitch within
-    1e-6 m / 1e-6 rad at every output time up to 0.25 s."""
-    a = lee(duration=EARLY, tolerance=1e-11)
-    r = tb.simulate(tb.Scenario.paper(duration=EARLY, tolerance=1e-11))
+@pytest.mark.parametrize("tol", [1e-10, 1e-11])
+def test_early_trajectory_agrees_at_tight_tolerance(tol):
+    """With both solvers' integration errors small: chassis y and pitch within 1e-6 m /
+    1e-6 rad at every output time up to 0.25 s (measured 2.9e-7 / 5.1e-7 at 1e-10,
+    2.6e-7 / 4.7e-7 at 1e-11)."""
+    a = lee(duration=EARLY, tolerance=tol)
+    r = tb.simulate(tb.Scenario.paper(duration=EARLY, tolerance=tol))
     d = _early_diff(a, r)
-    print("lee vs reduced at tol 1e-11:", d)
+    print(f"lee vs reduced at tol {tol:g}:", d)
     assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
 
 
 def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short):
-    """Chassis y and pitch within 1e-6 up to 0.25 s at the default tolerance (measured
-    4.3e-7 m / 1.8e-7 rad; the reduced solver locates contact onsets, solvers/events.py)."""
-    d = _early_diff(lee_short, paper_run_short)
-    print("lee vs reduced at the default tolerance:", d)
-    assert d["chassis_y"] <= 1e-6 and d["chassis_pitch"] <= 1e-6
-
-
-def test_trajectory_agrees_before_chaos_at_default_tolerance(lee_short, paper_run_short):
-    n = int(round(0.15 / 1e-4)) + 1
+    """At the default tolerance up to 0.2 s: within 1e-7 m / 1e-7 rad (measured 2.4e-8 m).
+    Between 0.2 and 0.25 s the motion starts to amplify differences ~100-fold: at
+    t = 0.25 s the lee run at 1e-9 is 1.0e-6 m from itself at 1e-11 (its own
+    integration error), the reduced run 2.8e-7 m; they differ by 1.1e-6 m there, so the
+    1e-6 bar up to 0.25 s is shown at tight tolerance (test above)."""
+    n = int(round(0.2 / 1e-4)) + 1
     for v in ("chassis_y", "chassis_pitch"):
-        assert np.abs(lee_short[v].values[:n] - paper_run_short[v].values[:n]).max() <= 1e-6
+        d = np.abs(lee_short[v].values[:n] - paper_run_short[v].values[:n]).max()
+        print(v, d)
+        assert d <= 1e-7
+
+
+def test_reported_acceleration_agrees_before_chaos(lee_short, paper_run_short):
+    """The lee run reports the chassis acceleration of converged multipliers (lee_loop.py,
+    DIAG_ACC_TOL): up to 0.15 s it matches the reduced solver's to 5e-3 m/s^2 (measured
+    1.0e-3; with the paper's 1e-9/h^2 acceleration tolerance alone it was 6.2e-2)."""
+    n = int(round(0.15 / 1e-4)) + 1
+    d = np.abs(lee_short.chassis_ay.values[:n] - paper_run_short.chassis_ay.values[:n]).max()
+    print("max |chassis_ay difference| up to 0.15 s:", d)
+    assert d <= 5e-3
 
 
 # ----------------------------------------------------------- cross-validation, late
@@ -160,25 +174,13 @@ def _out_of_range(lee_run, reduced_runs):
 # late ranges (the issue: "after 0.25 s, every summary quantity ...")
 EARLY_QUANTITIES = ("first_contact_time", "first_compression_time", "peak_wheel1_force_y_kN", "peak_wheel2_force_y_kN")
 
-# the quantities the spec names as chaotic-sensitive (late wheel 3-5 peaks, acceleration
-# extremes after 0.25 s, peak link tension): compared only in the non-strict xfail below
-SENSITIVE = ("peak_wheel3_force_y_kN", "peak_wheel4_force_y_kN", "peak_wheel5_force_y_kN", "peak_chassis_ay",
-             "min_chassis_ay", "peak_link_tension_kN")
-
 
 def test_late_summary_within_reduced_spread(lee_run, reduced_runs):
-    """Every summary quantity but the spec's sensitive ones lies in the reduced solver's
-    range over tolerances 1e-8..1e-11, widened by half its width on each side."""
+    """Every late summary quantity lies in the reduced solver's range over tolerances
+    1e-8..1e-11, widened by half its width on each side."""
     bad = _out_of_range(lee_run, reduced_runs)
     print("out of the widened reduced range (value, low, high):", bad)
-    assert not {k: v for k, v in bad.items() if k not in SENSITIVE}
-
-
-@pytest.mark.xfail(strict=False, reason="chaotic late quantities (peak link tension, late acceleration extremes, "
-                   "late wheel 3-5 peaks) may miss the widened range; which ones miss changes with any perturbation "
-                   "(spec: 10-60 % between correct runs); the test prints the figures")
-def test_late_summary_all_within_reduced_spread(lee_run, reduced_runs):
-    assert not _out_of_range(lee_run, reduced_runs)
+    assert not bad
 
 
 def test_energy(lee_run, paper_run):

@@ -27,7 +27,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .kernels import track_loads
+from .jit import KERNEL
+from .kernels import track_loads_call as track_loads
 from .layout import (
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, D_WHEEL,
     P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY,
@@ -188,7 +189,7 @@ def constraint_matrix(geo, minv, G):
                 G[2 * i + r, 2 * i + k] += ia * si[r] * si[k] + (ma if r == k else 0.0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, F, fc, diag):
     """F = applied generalised forces (no lambda) at z; fc = contact-only force on every
     pin (tension removed), fwheel (in work) = contact force on each wheel; diag filled by

@@ -6,15 +6,17 @@ each arm's moment balance about its pivot, so they are eliminated from the Newto
 iteration and computed afterwards.
 """
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 
 from . import layout as L
-from .kernels import allocate_neighbours, track_loads
+from .jit import KERNEL
+from .kernels import allocate_neighbours
 from .parameters import equilibrium_arm_angle, pack, total_mass
-from .reduced import allocate_work, positions
+from .reduced import allocate_work, reduced_rhs
 from .terrain import flat_ground
 
 
@@ -128,19 +130,42 @@ class _Problem:
         return r, fx, arm_moment
 
     def jacobian(self, u, h=1e-7):
+        """Central finite differences of the residual (a Python loop over compiled
+        residuals: 2 x 60 calls cost less than compiling the loop)."""
+        args = self._args()
+        rp = np.empty(u.size)
+        rm = np.empty(u.size)
+        am = np.empty(self.nw)
         J = np.empty((u.size, u.size))
-        _jacobian(u, h, *self._args(), J)
+        up = u.copy()
+        for k in range(u.size):
+            up[k] = u[k] + h
+            _residual(up, *args, rp, am)
+            up[k] = u[k] - h
+            _residual(up, *args, rm, am)
+            up[k] = u[k]
+            J[:, k] = (rp - rm) / (2.0 * h)
         return J
 
     def loads(self, q):
         apos, avel, fpin, fwheel, wc, wv, lk, arm = self.work
-        positions(q, np.zeros(self.nq), self.par, self.arms, self.ends, apos, avel, wc, wv, arm)
-        track_loads(apos, avel, wc, wv, self.par, self.seg, self.corners, self.nbr, self.ref,
-                    lk, fpin, fwheel, self.diag, L.diag_tension(self.nw))
+        _loads_at_rest(q, self.par, self.arms, self.ends, self.seg, self.corners, self.nbr, self.ref,
+                       self.work, self.diag)
         return apos, fpin, fwheel, wc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
+def _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag):
+    """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
+    The solver's own right-hand side computes them: one compiled copy of the contact code."""
+    nq = q.shape[0]
+    y = np.zeros(2 * nq + 1)
+    y[:nq] = q
+    ydot = np.empty(2 * nq + 1)
+    reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag)
+
+
+@njit(**KERNEL)
 def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, arm_moment):
     """Force balance of every free pin, vertical force and moment of chassis + arms
     (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
@@ -153,8 +178,9 @@ def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, ar
     q[L.Q_PITCH] = u[1]
     q[L.Q_ARM:L.Q_ARM + nw] = phi
     q[L.Q_ARM + nw:] = u[2:]
-    c, s = positions(q, np.zeros(nq), par, arms, ends, apos, avel, wc, wv, arm)
-    track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, L.D_WHEEL + 2 * nw)
+    _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag)
+    c = math.cos(u[1])
+    s = math.sin(u[1])
     g = par[L.P_GRAVITY]
     ma = par[L.P_ARM_MASS]
     yc = u[0]
@@ -177,22 +203,6 @@ def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, ar
         r[2 * b] = fpin[b, 0]
         r[2 * b + 1] = fpin[b, 1] - par[L.P_PIN_MASS] * g
     return fx
-
-
-@njit(cache=True, error_model="numpy")
-def _jacobian(u, h, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, J):
-    """Central finite differences of _residual."""
-    rp = np.empty(u.size)
-    rm = np.empty(u.size)
-    am = np.empty(arms.shape[0])
-    up = u.copy()
-    for k in range(u.size):
-        up[k] = u[k] + h
-        _residual(up, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, rp, am)
-        up[k] = u[k] - h
-        _residual(up, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, rm, am)
-        up[k] = u[k]
-        J[:, k] = (rp - rm) / (2.0 * h)
 
 
 def solve_equilibrium(vehicle, track, gravity, tol_rel=1e-12, max_iter=60):

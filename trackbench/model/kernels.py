@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from ..results import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
+from .jit import INLINE, KERNEL
 from .layout import (
     D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
     D_MAX_TENSION, D_MIN_TENSION, D_POWER, D_STATUS, D_WHEEL, P_K_GROUND, P_K_WHEEL,
@@ -30,7 +31,7 @@ from .layout import (
 )
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(**INLINE)
 def _seg_dist2(px, py, ax, ay, bx, by):
     """Squared distance from point P to segment AB."""
     ex = bx - ax
@@ -45,7 +46,7 @@ def _seg_dist2(px, py, ax, ay, bx, by):
     return dx * dx + dy * dy
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def build_neighbours(apos, wc, par, seg, corners, nbr):
     """Fill the candidate lists: every pair that could touch while no pin or wheel
     moves more than half the skin from where it is now."""
@@ -108,7 +109,7 @@ def build_neighbours(apos, wc, par, seg, corners, nbr):
         nbr[r_ps + b, 0] = n
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
     """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
     (so the lists always hold every pair that can touch: results equal a full search)."""
@@ -119,16 +120,11 @@ def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
     for b in range(n_pins):
         dx = apos[b, 0] - ref[b, 0]
         dy = apos[b, 1] - ref[b, 1]
-        if not (dx * dx + dy * dy <= lim):
-            stale = True
-            break
-    if not stale:
-        for i in range(wc.shape[0]):
-            dx = wc[i, 0] - ref[n_pins + i, 0]
-            dy = wc[i, 1] - ref[n_pins + i, 1]
-            if not (dx * dx + dy * dy <= lim):
-                stale = True
-                break
+        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
+    for i in range(wc.shape[0]):
+        dx = wc[i, 0] - ref[n_pins + i, 0]
+        dy = wc[i, 1] - ref[n_pins + i, 1]
+        stale |= not (dx * dx + dy * dy <= lim)
     if stale:
         build_neighbours(apos, wc, par, seg, corners, nbr)
         for b in range(n_pins):
@@ -140,7 +136,7 @@ def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
         nbr[nbr.shape[0] - 1, 0] += 1
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def link_tensions(apos, par, lk, fpin, diag, t_off):
     """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; sets fpin to the pull
     on every pin, stores t and length in lk and T in diag[t_off + b]."""
@@ -151,16 +147,20 @@ def link_tensions(apos, par, lk, fpin, diag, t_off):
     energy = 0.0
     tmin = np.inf
     tmax = -np.inf
-    for b in range(apos.shape[0] - 1):
+    n_links = apos.shape[0] - 1
+    for b in range(n_links):  # lengths first: a loop of square roots that vectorises
         dx = apos[b + 1, 0] - apos[b, 0]
         dy = apos[b + 1, 1] - apos[b, 1]
-        length = math.sqrt(dx * dx + dy * dy)
+        lk[b, 0] = dx
+        lk[b, 1] = dy
+        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
+    for b in range(n_links):
+        length = lk[b, 2]
         inv = 1.0 / length
-        tx = dx * inv
-        ty = dy * inv
+        tx = lk[b, 0] * inv
+        ty = lk[b, 1] * inv
         lk[b, 0] = tx
         lk[b, 1] = ty
-        lk[b, 2] = length
         stretch = length - l0
         tension = k * stretch
         diag[t_off + b] = tension
@@ -176,7 +176,7 @@ def link_tensions(apos, par, lk, fpin, diag, t_off):
     diag[D_MAX_TENSION] = tmax
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(**KERNEL)
 def _link_load(fpin, avel, b, d0, length, fx, fy):
     """Eq. (7): split a force on link b at distance d0 from pin b to pins b and b+1;
     returns the power of the split force."""
@@ -189,7 +189,7 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
     return (w0 * avel[b, 0] + w1 * avel[b + 1, 0]) * fx + (w0 * avel[b, 1] + w1 * avel[b + 1, 1]) * fy
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
     """Road wheel against link (Fig. 3, Eq. 4) and against pin in the wedge (Fig. 4)."""
     nw = wc.shape[0]
@@ -256,7 +256,7 @@ def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
     diag[D_POWER] += power
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
     """Pin on ground segment (Fig. 5 left, Eq. 6), ground corner on link (Fig. 5 right)
     and corner on pin in the wedge (Fig. 6)."""
@@ -385,7 +385,7 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
     diag[D_POWER] += power
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off):
     """All forces of the track model for given pin and wheel positions/velocities
     (fpin is overwritten, tension first):
@@ -398,6 +398,13 @@ def track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwhee
     link_tensions(apos, par, lk, fpin, diag, t_off)
     wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag)
     ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag)
+
+
+@njit(**KERNEL)
+def track_loads_call(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off):
+    """track_loads compiled once as a function of its own, for the callers off the
+    reduced solver's hot path (equilibrium, lee): each inlined copy costs compile time."""
+    track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off)
 
 
 def allocate_neighbours(n_wheels, n_corners, n_links, n_seg):

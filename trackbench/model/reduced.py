@@ -10,6 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .jit import INLINE, KERNEL
 from .kernels import track_loads
 from .layout import (
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_POWER, D_E_KINETIC, D_E_TORSION, P_ARM_INERTIA,
@@ -26,7 +27,7 @@ def allocate_work(n_wheels, n_links):
             np.zeros((n_links, 3)), np.zeros((n_wheels, 6)))
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**INLINE)
 def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
     """Pin and wheel-centre positions and velocities from the reduced state; keeps
     cos and sin of each arm's absolute angle in arm[:, 4:6] for the caller."""
@@ -66,7 +67,7 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
     return c, s
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag):
     """ydot = f(y) for y = (q, qd, W); fills diag (forces, energies, status).
 

@@ -17,7 +17,7 @@ from ..model.layout import P_ARM_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADI
 BISECTIONS = 24
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _coord(y0, f0, y1, f1, h, t, k, nq):
     """Quintic Hermite of coordinate k at t in [0, 1] (same basis as monitor.py)."""
     t2 = t * t
@@ -60,7 +60,7 @@ def _wheel(i, y0, f0, y1, f1, h, t, nq, par, arms):
             y + s * arms[i, 0] + c * arms[i, 1] + la * math.sin(beta))
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _pair_gap(kind, px, py, ax, ay, bx, by, cx, cy, reach):
     """(valid, reach - s) for point P against link A->B (kinds 0, 3) or against pin A in the
     wedge after the link C->A (kinds 1, 4); see _gap."""
@@ -85,7 +85,7 @@ def _pair_gap(kind, px, py, ax, ay, bx, by, cx, cy, reach):
     return wedge and convex, reach - math.sqrt(dx * dx + dy * dy)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _seg_gap(px, py, seg, j, hg):
     dx = px - seg[j, 0]
     dy = py - seg[j, 1]
@@ -138,7 +138,7 @@ def _points(y, nq, par, arms, ends, pins, wheels):
         wheels[i, 1] = y[Q_Y] + s * arms[i, 0] + c * arms[i, 1] + la * math.sin(beta)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, error_model="numpy")
 def _end_gap(kind, sg, b, pins, wheels, par, seg, corners):
     """_gap at an end of the step, from precomputed points."""
     if kind == 2:

@@ -11,6 +11,8 @@ from ..model.layout import (
     PK_FIRST_CORNER, PK_GROUND_FY, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
 )
 
+STEP_RATIO = 4.0  # largest ratio of neighbouring step sizes for the parabola refinement
+
 
 @njit(cache=True, error_model="numpy")
 def energy_balance(diag):
@@ -50,12 +52,14 @@ def _max(peaks, k, v, t):
 def _up(peaks, k, v, t):
     """Running maximum of a quantity sampled at every accepted step. A local maximum at
     the previous step is refined by the parabola through the last three samples, so a
-    smooth peak is found to O(h^3) rather than to the step spacing (O(h^2))."""
+    smooth peak is found to O(h^3) rather than to the step spacing (O(h^2)). Only
+    between steps of similar size: next to a contact onset (a kink, met by a tiny
+    located step) or an iteration's noise a parabola overshoots the true extreme."""
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
     f0, t0, f1, t1 = peaks[k, 2], peaks[k, 3], peaks[k, 4], peaks[k, 5]
-    if f1 >= f0 and f1 >= v and t1 > t0 and t > t1:
+    if f1 >= f0 and f1 >= v and t0 < t1 < t and (t - t1) <= STEP_RATIO * (t1 - t0) <= STEP_RATIO ** 2 * (t - t1):
         d01 = (f1 - f0) / (t1 - t0)
         d12 = (v - f1) / (t - t1)
         a = (d12 - d01) / (t - t0)
