@@ -28,7 +28,7 @@ import numpy as np
 from numba import njit
 
 from .jit import KERNEL
-from .kernels import track_loads_call as track_loads
+from .kernels import track_loads
 from .layout import (
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, D_WHEEL,
     P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY,

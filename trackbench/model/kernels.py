@@ -400,13 +400,6 @@ def track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwhee
     ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag)
 
 
-@njit(**KERNEL)
-def track_loads_call(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off):
-    """track_loads compiled once as a function of its own, for the callers off the
-    reduced solver's hot path (equilibrium, lee): each inlined copy costs compile time."""
-    track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off)
-
-
 def allocate_neighbours(n_wheels, n_corners, n_links, n_seg):
     """Empty neighbour lists (marked stale) for a model of this size."""
     rows = 2 * n_wheels + 2 * n_corners + (n_links + 1) + 1
