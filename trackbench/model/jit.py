@@ -1,15 +1,15 @@
-"""Compile options shared by the model kernels and the time loops.
-
-FASTMATH lets LLVM contract a*b+c into FMAs, reassociate sums and min/max reductions
-(so they vectorise), and divide by multiplying with a reciprocal: results change in the
-last bits only. It leaves out "nnan" and "ninf" on purpose: the solvers detect a
-diverged run by NaN/inf checks, which those flags would let the compiler delete.
+"""Compile options shared by the model kernels.
 
 The contact kernels are small and called once per right-hand side: INLINE folds them
 into their caller at numba-IR level (no call overhead, array reference counts pruned
-across the whole right-hand side; ~20 % of its time).
+across the whole right-hand side; ~20 % of its time). It costs compile time (numba
+copies the inlined IR), so only the right-hand sides inline them.
+
+No fastmath: with "reassoc" LLVM may order a sum differently in each place a function
+is compiled into, and a run then gave other numbers (after 0.25 s: the motion is
+chaotic) depending on which cached copy numba loaded first. Without it every copy
+rounds alike and a run is reproducible bit for bit.
 """
 
-FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
-KERNEL = {"cache": True, "error_model": "numpy", "fastmath": FASTMATH}
+KERNEL = {"cache": True, "error_model": "numpy"}
 INLINE = dict(KERNEL, inline="always")

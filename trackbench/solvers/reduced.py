@@ -21,14 +21,16 @@ FAC_MAX = 10.0
 
 @njit(cache=True, error_model="numpy")
 def _combine(y, h, w, K, m, out):
-    """out = y + h * sum_j<m w_j K_j (zero weights skipped; inner loop over the state)."""
-    out[:] = y
+    """out = y + h * sum_j<m w_j K_j (zero weights skipped). K is indexed in 2D, not by
+    row views: a view per stage costs reference counting (~6 % of a run)."""
+    n = out.shape[0]
+    for k in range(n):
+        out[k] = y[k]
     for j in range(m):
         c = h * w[j]
         if c != 0.0:
-            Kj = K[j]
-            for k in range(out.shape[0]):
-                out[k] += c * Kj[k]
+            for k in range(n):
+                out[k] += c * K[j, k]
 
 
 @njit(cache=True, error_model="numpy")
@@ -36,16 +38,18 @@ def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
     use3 = e3[0] != 0.0
-    er5[:] = 0.0
-    er3[:] = 0.0
+    for k in range(n):
+        er5[k] = 0.0
+        er3[k] = 0.0
     for j in range(K.shape[0]):
-        Kj = K[j]
         if e[j] != 0.0:
+            ej = e[j]
             for k in range(n):
-                er5[k] += e[j] * Kj[k]
+                er5[k] += ej * K[j, k]
         if use3 and e3[j] != 0.0:
+            ej = e3[j]
             for k in range(n):
-                er3[k] += e3[j] * Kj[k]
+                er3[k] += ej * K[j, k]
     s5 = 0.0
     s3 = 0.0
     for k in range(n):
