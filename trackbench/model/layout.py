@@ -91,7 +91,8 @@ PK_ENERGY_BALANCE = 6    # max |paper energy balance - initial| (J)
 PK_ENERGY_RESIDUAL = 7   # max |work-based residual| (J)
 PK_FIRST_CORNER = 8      # value 1 once a ground corner touched the track; time of first touch
 PK_FIRST_COMPRESSION = 9  # value 1 once any link went into compression; time of first
-PK_WHEEL_FY = 10         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
+PK_SWITCH = 10           # time (column 1) of the last step ended at a located contact switch
+PK_WHEEL_FY = 11         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
 
 
 def n_peaks(n_wheels):

@@ -143,7 +143,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     r_ref = energy_residual(diags[0], W)
     stats[S_E0] = e_ref - diags[0, D_E_GRAVITY]
     init_peaks(peaks)
-    update_peaks(peaks, 0.0, diags[0], zd[0], W, e_ref, r_ref)
+    update_peaks(peaks, 0.0, diags[0], zd[0], W, e_ref, r_ref, False)
     to_reduced(z, zd, W, nw, yred)
     out_y[0, :] = yred
     out_d[0, :] = diags[0]
@@ -275,7 +275,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
                 status = NAN
         if diag[D_STATUS] != 0.0:
             status = int(diag[D_STATUS])
-        update_peaks(peaks, t_new, diag, zd_new[0], W_new, e_ref, r_ref)
+        update_peaks(peaks, t_new, diag, zd_new[0], W_new, e_ref, r_ref, False)
         rp = err_p / ptol
         rv = err_v * h / ptol
         ra = err_a * h * h / ptol

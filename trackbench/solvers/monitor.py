@@ -8,10 +8,13 @@ from ..model.layout import (
     D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
     D_E_TENSION, D_E_TORSION, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_WHEEL,
     PK_AY_MAX, PK_AY_MIN, PK_ENERGY_BALANCE, PK_ENERGY_RESIDUAL, PK_FIRST_COMPRESSION,
-    PK_FIRST_CORNER, PK_GROUND_FY, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
+    PK_FIRST_CORNER, PK_GROUND_FY, PK_SWITCH, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
 )
-
-STEP_RATIO = 4.0  # largest ratio of neighbouring step sizes for the parabola refinement
+# The step-size controller grows a step at most 10x (FAC_MAX), so neighbouring steps
+# more unequal than this follow a rejection: a contact switch, a kink or a jump the error
+# estimate caught. A parabola through such samples can overshoot by many times the
+# change over the short step (a wheel-5 peak of 4.06 MN where the samples reach 1.8 MN).
+STEP_RATIO = 12.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -39,6 +42,7 @@ def init_peaks(peaks):
     peaks[PK_FIRST_COMPRESSION, 0] = 0.0
     peaks[PK_ENERGY_BALANCE, 0] = 0.0
     peaks[PK_ENERGY_RESIDUAL, 0] = 0.0
+    peaks[PK_SWITCH, :] = -1.0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -49,17 +53,19 @@ def _max(peaks, k, v, t):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _up(peaks, k, v, t):
+def _up(peaks, k, v, t, t_switch):
     """Running maximum of a quantity sampled at every accepted step. A local maximum at
     the previous step is refined by the parabola through the last three samples, so a
-    smooth peak is found to O(h^3) rather than to the step spacing (O(h^2)). Only
-    between steps of similar size: next to a contact onset (a kink, met by a tiny
-    located step) or an iteration's noise a parabola overshoots the true extreme."""
+    smooth peak is found to O(h^3) rather than to the step spacing (O(h^2)). Not when the
+    previous step ended at a located contact switch (t_switch): there the quantity has a
+    kink, its extreme is the sample itself, and a parabola would overshoot it; nor across
+    steps more unequal than STEP_RATIO."""
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
     f0, t0, f1, t1 = peaks[k, 2], peaks[k, 3], peaks[k, 4], peaks[k, 5]
-    if f1 >= f0 and f1 >= v and t0 < t1 < t and (t - t1) <= STEP_RATIO * (t1 - t0) <= STEP_RATIO ** 2 * (t - t1):
+    if (f1 >= f0 and f1 >= v and t1 != t_switch and t0 < t1 < t
+            and (t - t1) <= STEP_RATIO * (t1 - t0) <= STEP_RATIO ** 2 * (t - t1)):
         d01 = (f1 - f0) / (t1 - t0)
         d12 = (v - f1) / (t - t1)
         a = (d12 - d01) / (t - t0)
@@ -77,21 +83,25 @@ def _up(peaks, k, v, t):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _down(peaks, k, v, t):
+def _down(peaks, k, v, t, t_switch):
     """Running minimum, refined like _up (the history holds -v)."""
     peaks[k, 0] = -peaks[k, 0]
-    _up(peaks, k, -v, t)
+    _up(peaks, k, -v, t, t_switch)
     peaks[k, 0] = -peaks[k, 0]
 
 
 @njit(cache=True, error_model="numpy")
-def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
-    """e_ref, r_ref: energy balance and residual at t = 0."""
+def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
+    """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
+    shortened to end just after a located contact switch (solvers/events.py)."""
+    if at_switch:
+        peaks[PK_SWITCH, 1] = t
+    ts = peaks[PK_SWITCH, 1]
     nw = peaks.shape[0] - PK_WHEEL_FY
     for i in range(nw):
-        _up(peaks, PK_WHEEL_FY + i, diag[D_WHEEL + 2 * i + 1], t)
-    _up(peaks, PK_GROUND_FY, diag[D_GROUND_FY], t)
-    _up(peaks, PK_TENSION_MAX, diag[D_MAX_TENSION], t)
+        _up(peaks, PK_WHEEL_FY + i, diag[D_WHEEL + 2 * i + 1], t, ts)
+    _up(peaks, PK_GROUND_FY, diag[D_GROUND_FY], t, ts)
+    _up(peaks, PK_TENSION_MAX, diag[D_MAX_TENSION], t, ts)
     if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
         # the crossing time, linear between the last two steps (history holds -T_min)
         f0 = -peaks[PK_TENSION_MIN, 4]
@@ -101,10 +111,10 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref):
             tc = t0 + f0 / (f0 - diag[D_MIN_TENSION]) * (t - t0)
         peaks[PK_FIRST_COMPRESSION, 0] = 1.0
         peaks[PK_FIRST_COMPRESSION, 1] = tc
-    _down(peaks, PK_TENSION_MIN, diag[D_MIN_TENSION], t)
-    _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t)
-    _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t)
-    _down(peaks, PK_VX_MIN, vx, t)
+    _down(peaks, PK_TENSION_MIN, diag[D_MIN_TENSION], t, ts)
+    _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t, ts)
+    _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t, ts)
+    _down(peaks, PK_VX_MIN, vx, t, ts)
     _max(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
     _max(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
     if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:

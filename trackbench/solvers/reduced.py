@@ -89,7 +89,7 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     r_ref = energy_residual(diag, y[ny - 1])
     stats[S_E0] = e_ref - diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
     init_peaks(peaks)
-    update_peaks(peaks, 0.0, diag, y[nq + Q_X], y[ny - 1], e_ref, r_ref)
+    update_peaks(peaks, 0.0, diag, y[nq + Q_X], y[ny - 1], e_ref, r_ref, False)
     out_y[0, :] = y
     out_d[0, :] = diag
     n_out = 1
@@ -104,6 +104,7 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     h_lo = np.inf
     h_hi = 0.0
     fac_max = FAC_MAX
+    at_switch = False  # the step being tried ends just after a located contact switch
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         if steps + rejected >= max_steps:
             status = MAX_STEPS
@@ -126,11 +127,13 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
                 # a contact starting or ending inside the step: end the retry just after it
                 th = first_contact_switch(y, K[0], y_new, K[s], h, par, arms, ends, seg, corners, nbr,
                                           pins0, pins1, wheels0, wheels1)
-                if th < 1.0 and th * h > h_min:
+                at_switch = th < 1.0 and th * h > h_min
+                if at_switch:
                     h *= th
                 else:
                     h *= max(FAC_MIN, SAFETY * err ** expo)
             else:
+                at_switch = False
                 h *= FAC_MIN
             fac_max = 1.0
             continue
@@ -144,7 +147,8 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
                 status = NAN
         if diag[D_STATUS] != 0.0:
             status = int(diag[D_STATUS])
-        update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[ny - 1], e_ref, r_ref)
+        update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[ny - 1], e_ref, r_ref, at_switch)
+        at_switch = False
         # output samples in (t, t_new]
         while n_out < n_out_max and n_out * dt_out <= t_new * (1.0 + 1e-12):
             t_o = n_out * dt_out
