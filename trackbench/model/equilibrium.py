@@ -160,7 +160,8 @@ def _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag):
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
     y = np.zeros(2 * nq + 1)
-    y[:nq] = q
+    for k in range(nq):  # loops, not slice assignments: see solvers/reduced._set_row
+        y[k] = q[k]
     ydot = np.empty(2 * nq + 1)
     reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag)
 
@@ -176,8 +177,10 @@ def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, ar
     q = np.zeros(nq)
     q[L.Q_Y] = u[0]
     q[L.Q_PITCH] = u[1]
-    q[L.Q_ARM:L.Q_ARM + nw] = phi
-    q[L.Q_ARM + nw:] = u[2:]
+    for i in range(nw):
+        q[L.Q_ARM + i] = phi  # every arm at the same equilibrium angle
+    for k in range(2, u.shape[0]):
+        q[L.Q_ARM + nw + k - 2] = u[k]
     _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag)
     c = math.cos(u[1])
     s = math.sin(u[1])

@@ -40,7 +40,7 @@ from .monitor import energy_balance, energy_residual, hermite_second_order, init
 SAFETY = 0.9
 FAC_MIN = 0.2
 FAC_MAX = 10.0
-# diag's chassis acceleration (output samples and the peaks of every accepted step) is that of the
+# diag's chassis acceleration and the joint forces (output samples, peaks of every accepted step) are those of the
 # state with the multipliers iterated on from the level-4 value to this constraint-acceleration error
 # (m/s^2): 1e-9 / h^2 leaves up to ~20 m/s^2 at h ~ 7e-6 s (~0.2 m/s^2 on the chassis, 4.5 at worst).
 # A copy of lambda is used, so lambda(t + h), qdd(t + h) and the trajectory stay the paper's.
@@ -147,7 +147,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     to_reduced(z, zd, W, nw, yred)
     out_y[0, :] = yred
     out_d[0, :] = diags[0]
-    out_lam[0, :] = lam0
+    out_lam[0, :] = lam_d  # the converged multipliers, as for diag
     out_x[0, :] = 0.0
     out_x[0, X_ERR_ACC] = err_a
     n_out = 1
@@ -313,7 +313,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             finish_diag(zo, zdo, zdd_d, par, arms, contact_power(zo, zdo, ends, fco, work[3], nw), out_d[n_out])
             to_reduced(zo, zdo, yo[2 * nz], nw, yred)
             out_y[n_out, :] = yred
-            out_lam[n_out, :] = lam_o
+            out_lam[n_out, :] = lam_d
             out_x[n_out, :] = acc_x
             acc_x[:] = 0.0
             acc_x[X_H] = h

@@ -82,14 +82,6 @@ def _up(peaks, k, v, t, t_switch):
     peaks[k, 5] = t
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _down(peaks, k, v, t, t_switch):
-    """Running minimum, refined like _up (the history holds -v)."""
-    peaks[k, 0] = -peaks[k, 0]
-    _up(peaks, k, -v, t, t_switch)
-    peaks[k, 0] = -peaks[k, 0]
-
-
 @njit(cache=True, error_model="numpy")
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
@@ -98,10 +90,6 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
         peaks[PK_SWITCH, 1] = t
     ts = peaks[PK_SWITCH, 1]
     nw = peaks.shape[0] - PK_WHEEL_FY
-    for i in range(nw):
-        _up(peaks, PK_WHEEL_FY + i, diag[D_WHEEL + 2 * i + 1], t, ts)
-    _up(peaks, PK_GROUND_FY, diag[D_GROUND_FY], t, ts)
-    _up(peaks, PK_TENSION_MAX, diag[D_MAX_TENSION], t, ts)
     if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
         # the crossing time, linear between the last two steps (history holds -T_min)
         f0 = -peaks[PK_TENSION_MIN, 4]
@@ -111,10 +99,37 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
             tc = t0 + f0 / (f0 - diag[D_MIN_TENSION]) * (t - t0)
         peaks[PK_FIRST_COMPRESSION, 0] = 1.0
         peaks[PK_FIRST_COMPRESSION, 1] = tc
-    _down(peaks, PK_TENSION_MIN, diag[D_MIN_TENSION], t, ts)
-    _up(peaks, PK_AY_MAX, diag[D_CHASSIS_AY], t, ts)
-    _down(peaks, PK_AY_MIN, diag[D_CHASSIS_AY], t, ts)
-    _down(peaks, PK_VX_MIN, vx, t, ts)
+    # one call site of the inlined _up (each inlined copy costs compile time); a minimum
+    # is the maximum of -v, with the row's value and history kept negated meanwhile
+    for j in range(nw + 6):
+        sign = 1.0
+        if j < nw:
+            k = PK_WHEEL_FY + j
+            v = diag[D_WHEEL + 2 * j + 1]
+        elif j == nw:
+            k = PK_GROUND_FY
+            v = diag[D_GROUND_FY]
+        elif j == nw + 1:
+            k = PK_TENSION_MAX
+            v = diag[D_MAX_TENSION]
+        elif j == nw + 2:
+            k = PK_TENSION_MIN
+            v = diag[D_MIN_TENSION]
+            sign = -1.0
+        elif j == nw + 3:
+            k = PK_AY_MAX
+            v = diag[D_CHASSIS_AY]
+        elif j == nw + 4:
+            k = PK_AY_MIN
+            v = diag[D_CHASSIS_AY]
+            sign = -1.0
+        else:
+            k = PK_VX_MIN
+            v = vx
+            sign = -1.0
+        peaks[k, 0] *= sign
+        _up(peaks, k, sign * v, t, ts)
+        peaks[k, 0] *= sign
     _max(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
     _max(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
     if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:

@@ -34,6 +34,14 @@ def _combine(y, h, w, K, m, out):
 
 
 @njit(cache=True, error_model="numpy")
+def _set_row(a, i, v):
+    """a[i, :] = v as a loop: numba's slice assignment compiles its shape-mismatch error
+    message (string formatting), ~4 s of every cold start."""
+    for k in range(v.shape[0]):
+        a[i, k] = v[k]
+
+
+@njit(cache=True, error_model="numpy")
 def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
@@ -90,8 +98,8 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     stats[S_E0] = e_ref - diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
     init_peaks(peaks)
     update_peaks(peaks, 0.0, diag, y[nq + Q_X], y[ny - 1], e_ref, r_ref, False)
-    out_y[0, :] = y
-    out_d[0, :] = diag
+    _set_row(out_y, 0, y)
+    _set_row(out_d, 0, diag)
     n_out = 1
     n_out_max = out_y.shape[0]
     status = SUCCESSFUL
@@ -154,13 +162,14 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
             t_o = n_out * dt_out
             theta = min(1.0, (t_o - t) / h)
             hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
-            out_y[n_out, :] = ys
+            _set_row(out_y, n_out, ys)
             reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, fs, out_d[n_out])
             n_rhs += 1
             n_out += 1
         t = t_new
-        y[:] = y_new
-        K[0, :] = K[s]
+        for k in range(ny):
+            y[k] = y_new[k]
+            K[0, k] = K[s, k]
         if err == 0.0:
             fac = fac_max
         else:
