@@ -34,6 +34,7 @@ from ..model.layout import (D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_O
                             S_STATUS, S_STEPS, S_T_FINAL)
 from ..results import CONSTRAINT_ITERATION, MAX_STEPS, NAN, STEP_SIZE_UNDERFLOW, SUCCESSFUL
 from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
+from .events import first_contact_switch
 from .lee_stages import error_norm, rkn_pass, work_increment
 from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
 
@@ -100,6 +101,15 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     fb = np.zeros(2 * nz + 1)
     yo = np.zeros(2 * nz + 1)
     yred = np.zeros(y0.shape[0])
+    # scratch of the event location (reduced-coordinate views of a rejected step's ends)
+    ev_y0 = np.zeros(y0.shape[0])
+    ev_f0 = np.zeros(y0.shape[0])
+    ev_y1 = np.zeros(y0.shape[0])
+    ev_f1 = np.zeros(y0.shape[0])
+    ev_pins0 = np.empty((n_pins, 2))
+    ev_pins1 = np.empty((n_pins, 2))
+    ev_wheels0 = np.empty((nw, 2))
+    ev_wheels1 = np.empty((nw, 2))
     Fo = np.zeros(nz)
     fco = np.zeros((n_pins, 2))
     geo_o = np.zeros((nw, 4))
@@ -162,6 +172,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     h_lo = np.inf
     h_hi = 0.0
     fac_max = FAC_MAX
+    at_switch = False  # the step being tried ends just after a located contact switch
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         if steps + rejected >= max_steps:
             status = MAX_STEPS
@@ -204,6 +215,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             rejected += 1
             lstats[L_REJ_CONSTRAINT] += 1
             acc_x[X_REJECTED] += 1
+            at_switch = False
             h *= 0.5
             fac_max = 1.0
             continue
@@ -214,8 +226,22 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             lstats[L_REJ_ERROR] += 1
             acc_x[X_REJECTED] += 1
             if err == err and err > 0.0:
-                h *= max(FAC_MIN, SAFETY * err ** expo)
+                # a contact starting or ending inside the step: end the retry just after it
+                # (solvers/events.py, on the step's ends in reduced coordinates; the last
+                # stage, c = 1, is the acceleration at t + h)
+                to_reduced(z, zd, 0.0, nw, ev_y0)
+                to_reduced(zd, zdd, 0.0, nw, ev_f0)
+                to_reduced(Y, zd_new, 0.0, nw, ev_y1)
+                to_reduced(zd_new, K[ns - 1], 0.0, nw, ev_f1)
+                th = first_contact_switch(ev_y0, ev_f0, ev_y1, ev_f1, h, par, arms, ends, seg, corners, nbr,
+                                          ev_pins0, ev_pins1, ev_wheels0, ev_wheels1)
+                at_switch = th < 1.0 and th * h > h_min
+                if at_switch:
+                    h *= th
+                else:
+                    h *= max(FAC_MIN, SAFETY * err ** expo)
             else:
+                at_switch = False
                 h *= FAC_MIN
             fac_max = 1.0
             continue
@@ -275,7 +301,8 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
                 status = NAN
         if diag[D_STATUS] != 0.0:
             status = int(diag[D_STATUS])
-        update_peaks(peaks, t_new, diag, zd_new[0], W_new, e_ref, r_ref, False)
+        update_peaks(peaks, t_new, diag, zd_new[0], W_new, e_ref, r_ref, at_switch)
+        at_switch = False
         rp = err_p / ptol
         rv = err_v * h / ptol
         ra = err_a * h * h / ptol
