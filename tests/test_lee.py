@@ -2,8 +2,9 @@
 iteration, Dormand-Prince RKN6(4) steps; cross-validated against the reduced solver.
 
 Runs are shared through module fixtures; every simulation is as short as its test
-needs. The one bar that depends on chance (the paper's 0.06 % energy balance over the
-whole chaotic run) is a non-strict xfail that prints its figures."""
+needs. Two bars depend on chance and are non-strict xfails that print their figures: the
+paper's 0.06 % energy balance over the whole chaotic run, and the issue's late range drawn
+from tolerance variation alone (narrower than the spread of correct runs)."""
 
 import math
 
@@ -129,8 +130,8 @@ def test_early_events_agree(lee_short, paper_run_short):
 @pytest.mark.parametrize("tol", [1e-10, 1e-11])
 def test_early_trajectory_agrees_at_tight_tolerance(tol):
     """With both solvers' integration errors small: chassis y and pitch within 1e-6 m /
-    1e-6 rad at every output time up to 0.25 s (measured 2.9e-7 / 5.1e-7 at 1e-10,
-    2.6e-7 / 4.7e-7 at 1e-11)."""
+    1e-6 rad at every output time up to 0.25 s (measured 3.7e-7 / 4.3e-7 at 1e-10,
+    5.3e-7 / 4.5e-7 at 1e-11)."""
     a = lee(duration=EARLY, tolerance=tol)
     r = tb.simulate(tb.Scenario.paper(duration=EARLY, tolerance=tol))
     d = _early_diff(a, r)
@@ -139,11 +140,11 @@ def test_early_trajectory_agrees_at_tight_tolerance(tol):
 
 
 def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short):
-    """At the default tolerance up to 0.2 s: within 1e-7 m / 1e-7 rad (measured 2.4e-8 m).
-    Between 0.2 and 0.25 s the motion starts to amplify differences ~100-fold: at
-    t = 0.25 s the lee run at 1e-9 is 1.0e-6 m from itself at 1e-11 (its own
-    integration error), the reduced run 2.8e-7 m; they differ by 1.1e-6 m there, so the
-    1e-6 bar up to 0.25 s is shown at tight tolerance (test above)."""
+    """At the default tolerance up to 0.2 s: within 1e-7 m / 1e-7 rad (measured 2.7e-8 m).
+    Between 0.2 and 0.25 s the motion starts to amplify differences ~100-fold, so at
+    0.25 s the difference depends on each solver's own integration error at 1e-9 (lee:
+    up to 1.0e-6 m against itself at 1e-11): 7.9e-7 m now, 1.1e-6 m in a build that
+    rounded differently. The 1e-6 bar up to 0.25 s is shown at tight tolerance (above)."""
     n = int(round(0.2 / 1e-4)) + 1
     for v in ("chassis_y", "chassis_pitch"):
         d = np.abs(lee_short[v].values[:n] - paper_run_short[v].values[:n]).max()
@@ -154,7 +155,7 @@ def test_early_trajectory_agrees_at_default_tolerance(lee_short, paper_run_short
 def test_reported_acceleration_agrees_before_chaos(lee_short, paper_run_short):
     """The lee run reports the chassis acceleration of converged multipliers (lee_loop.py,
     DIAG_ACC_TOL): up to 0.15 s it matches the reduced solver's to 5e-3 m/s^2 (measured
-    1.0e-3; with the paper's 1e-9/h^2 acceleration tolerance alone it was 6.2e-2)."""
+    6e-4; with the paper's 1e-9/h^2 acceleration tolerance alone it was 6.2e-2)."""
     n = int(round(0.15 / 1e-4)) + 1
     d = np.abs(lee_short.chassis_ay.values[:n] - paper_run_short.chassis_ay.values[:n]).max()
     print("max |chassis_ay difference| up to 0.15 s:", d)

@@ -61,3 +61,39 @@ def test_running_maximum_without_interior_peak():
     t = np.linspace(0.0, 1.0, 11)
     peak, when = _track(t, t ** 2)
     assert peak == 1.0 and when == 1.0
+
+
+# ------------------------------------------------------- through update_peaks (the solvers' entry)
+def _update_all(times, values, switch_times, row="wheel"):
+    """Feed update_peaks with `values` in one quantity (wheel 1's force, or the chassis
+    forward speed for its minimum); returns (peak, time) of that row."""
+    from trackbench.model import layout as L
+    from trackbench.solvers.monitor import init_peaks, update_peaks
+    nw = 5
+    peaks = np.zeros((L.n_peaks(nw), 6))
+    diag = np.zeros(L.n_diag(nw, 30))
+    init_peaks(peaks)
+    for t, v in zip(times, values):
+        vx = 10.0
+        if row == "wheel":
+            diag[L.D_WHEEL + 1] = v
+        else:
+            vx = v
+        update_peaks(peaks, t, diag, vx, 0.0, 0.0, 0.0, t in switch_times)
+    k = L.PK_WHEEL_FY if row == "wheel" else L.PK_VX_MIN
+    return peaks[k, 0], peaks[k, 1]
+
+
+def test_consecutive_switches_keep_the_kink():
+    # two steps in a row end at located switches (0.5, then 0.53): the parabola through
+    # (0.47, 0.5, 0.53) must still be skipped (it would report 0.50375 at 0.4925)
+    t = np.array([0.40, 0.47, 0.5, 0.53, 0.56])
+    peak, when = _update_all(t, kink(t), {0.5, 0.53})
+    assert peak == 0.5 and when == 0.5
+
+
+def test_minimum_is_refined_like_a_maximum():
+    t = np.arange(0.0, 1.0, 0.03)
+    low, when = _update_all(t, 9.0 - _bump(t), set(), row="vx")   # minimum 8 at t = 0.4111
+    assert abs(low - 8.0) < 1e-4 < (9.0 - _bump(t)).min() - 8.0
+    assert abs(when - 0.4111) < 2e-3

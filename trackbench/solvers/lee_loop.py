@@ -5,7 +5,9 @@
    to lam1; iterate lam1 by Eq. (15) with the position error Eq. (12) at t + h until
    max |Phi| <= position_tol, re-integrating the step (contacts re-detected at every
    stage) at each iteration. Non-convergence rejects the step (h / 2).
-2. Embedded error estimate; reject (and shrink h) or accept and pick the next h.
+2. Embedded error estimate; reject (and shrink h) or accept and pick the next h. A
+   rejected step in which a contact starts or ends is retried to end just after it
+   (solvers/events.py, on the step's ends in reduced coordinates), as in the reduced solver.
 3. Velocity level: with the stage forces of 1 held, iterate lambda with Eq. (13) to
    max |Phi_q qd| <= position_tol / h; this sets qd(t + h) of the chassis and arms.
 4. Acceleration level: with the forces at t + h, iterate lambda with Eq. (14) to
@@ -20,7 +22,8 @@ depends on the configuration only through these angles; the update keeps the pap
 form and the convergence tests are unchanged, only C is up to that much out of date.
 Output samples: quintic Hermite interpolation of (z, zd) (cubic for the contact work),
 then forces and the acceleration level at the sample, so diag means what reduced_rhs
-puts there.
+puts there. The chassis acceleration in diag (samples and peaks) and the joint forces come
+from a copy of the multipliers iterated on to DIAG_ACC_TOL (below).
 """
 
 import math
@@ -43,7 +46,8 @@ FAC_MIN = 0.2
 FAC_MAX = 10.0
 # diag's chassis acceleration and the joint forces (output samples, peaks of every accepted step) are those of the
 # state with the multipliers iterated on from the level-4 value to this constraint-acceleration error
-# (m/s^2): 1e-9 / h^2 leaves up to ~20 m/s^2 at h ~ 7e-6 s (~0.2 m/s^2 on the chassis, 4.5 at worst).
+# (m/s^2): 1e-9 / h^2 leaves up to ~20 m/s^2 at h ~ 7e-6 s (up to 0.6 m/s^2 on the chassis
+# before 0.25 s, 4.5 at worst).
 # A copy of lambda is used, so lambda(t + h), qdd(t + h) and the trajectory stay the paper's.
 DIAG_ACC_TOL = 1e-10
 DIAG_MAX_IT = 1000

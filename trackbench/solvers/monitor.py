@@ -86,9 +86,7 @@ def _up(peaks, k, v, t, t_switch):
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
     shortened to end just after a located contact switch (solvers/events.py)."""
-    if at_switch:
-        peaks[PK_SWITCH, 1] = t
-    ts = peaks[PK_SWITCH, 1]
+    ts = peaks[PK_SWITCH, 1]  # the last sample at a switch before this one (see _up)
     nw = peaks.shape[0] - PK_WHEEL_FY
     if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:
         # the crossing time, linear between the last two steps (history holds -T_min)
@@ -135,6 +133,8 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:
         peaks[PK_FIRST_CORNER, 0] = 1.0
         peaks[PK_FIRST_CORNER, 1] = t
+    if at_switch:
+        peaks[PK_SWITCH, 1] = t
 
 
 @njit(cache=True, error_model="numpy")
