@@ -160,6 +160,7 @@ def test_reported_acceleration_agrees_before_chaos(lee_short, paper_run_short):
     d = np.abs(lee_short.chassis_ay.values[:n] - paper_run_short.chassis_ay.values[:n]).max()
     print("max |chassis_ay difference| up to 0.15 s:", d)
     assert d <= 5e-3
+    assert int(lee_short.lee_reported_unconverged) == 0 < int(lee_short.lee_total_iterations_reported)
 
 
 # ----------------------------------------------------------- cross-validation, late

@@ -9,10 +9,10 @@ from ..model.absolute import inverse_mass
 from ..model.layout import S_N_OUT
 from ..output import _var
 from .base import allocate_outputs, trimmed
-from .lee_loop import (L_BUILDS, L_EPS1, L_IT_ACC, L_IT_OUT, L_IT_POS, L_IT_VEL, L_PASSES, L_RATIO_ACC, L_RATIO_POS,
-                       L_RATIO_VEL, L_REJ_CONSTRAINT, L_REJ_ERROR, N_L, N_X, X_ERR_ACC, X_ERR_POS, X_ERR_VEL,
-                       X_H, X_IT_ACC, X_IT_POS, X_IT_VEL, X_RATIO_ACC, X_RATIO_POS, X_RATIO_VEL, X_REJECTED,
-                       X_STEPS, integrate_lee)
+from .lee_loop import (L_BUILDS, L_DIAG_UNCONVERGED, L_EPS1, L_IT_ACC, L_IT_DIAG, L_IT_OUT, L_IT_POS,
+                       L_IT_VEL, L_PASSES, L_RATIO_ACC, L_RATIO_POS, L_RATIO_VEL, L_REJ_CONSTRAINT,
+                       L_REJ_ERROR, N_L, N_X, X_ERR_ACC, X_ERR_POS, X_ERR_VEL, X_H, X_IT_ACC, X_IT_POS,
+                       X_IT_VEL, X_RATIO_ACC, X_RATIO_POS, X_RATIO_VEL, X_REJECTED, X_STEPS, integrate_lee)
 from .rkn_tableau import RKN64
 
 H0 = 1e-5        # s: first trial step
@@ -67,6 +67,10 @@ def run(scenario, model, y0):
         ("lee_total_iterations_acceleration", L_IT_ACC, "1", "lambda iterations at the acceleration level, "
                                                              "whole run (output samples excluded)"),
         ("lee_total_iterations_output", L_IT_OUT, "1", "acceleration-level iterations at the output samples"),
+        ("lee_total_iterations_reported", L_IT_DIAG, "1", "further acceleration-level iterations (to 1e-10 m/s^2, "
+                                                          "on a copy) for the reported acceleration and joint forces"),
+        ("lee_reported_unconverged", L_DIAG_UNCONVERGED, "1", "reported states whose further iteration did not "
+                                                              "reach 1e-10 m/s^2 (their values are less accurate)"),
         ("lee_step_passes", L_PASSES, "1", "RKN passes over a step (one per position-level iteration + 1)"),
         ("lee_rejected_error", L_REJ_ERROR, "1", "steps rejected by the integration error test"),
         ("lee_rejected_constraint", L_REJ_CONSTRAINT, "1", "steps rejected because the position-level "

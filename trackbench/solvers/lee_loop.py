@@ -58,8 +58,17 @@ X_STEPS, X_REJECTED, X_IT_POS, X_IT_VEL, X_IT_ACC, X_ERR_POS, X_ERR_VEL, X_ERR_A
 N_X = 12
 # lstats: run totals
 L_IT_POS, L_IT_VEL, L_IT_ACC, L_PASSES, L_REJ_ERROR, L_REJ_CONSTRAINT, L_EPS1, \
-    L_RATIO_POS, L_RATIO_VEL, L_RATIO_ACC, L_IT_OUT, L_BUILDS = range(12)
-N_L = 12
+    L_RATIO_POS, L_RATIO_VEL, L_RATIO_ACC, L_IT_OUT, L_BUILDS, L_IT_DIAG, L_DIAG_UNCONVERGED = range(14)
+N_L = 14
+
+
+@njit(cache=True, error_model="numpy")
+def _count_diag(it, lstats):
+    """Bookkeeping of the DIAG_ACC_TOL iterations (it < 0: not converged in DIAG_MAX_IT)."""
+    if it < 0:
+        lstats[L_DIAG_UNCONVERGED] += 1
+    else:
+        lstats[L_IT_DIAG] += it
 
 
 @njit(cache=True, error_model="numpy")
@@ -150,8 +159,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     K[0, :] = zdd
     p_start = contact_power(z, zd, ends, fcs[0], fws[0], nw)
     lam_d[:] = lam0
-    acceleration_level(Fst[0], geos[0], zd, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT, nbody, zdd_d,
-                       gam, v)
+    it_d, _ = acceleration_level(Fst[0], geos[0], zd, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT, nbody,
+                                 zdd_d, gam, v)
+    _count_diag(it_d, lstats)
     finish_diag(z, zd, zdd_d, par, arms, p_start, diags[0])
     e_ref = energy_balance(diags[0])
     r_ref = energy_residual(diags[0], W)
@@ -297,8 +307,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
         yb[2 * nz] = W_new
         diag = diags[ns - 1]
         lam_d[:] = lam_s
-        acceleration_level(Fst[ns - 1], geos[ns - 1], zd_new, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL,
-                           DIAG_MAX_IT, nbody, zdd_d, gam, v)
+        it_d, _ = acceleration_level(Fst[ns - 1], geos[ns - 1], zd_new, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL,
+                                     DIAG_MAX_IT, nbody, zdd_d, gam, v)
+        _count_diag(it_d, lstats)
         finish_diag(Y, zd_new, zdd_d, par, arms, p_end, diag)
         for k in range(nz):
             if not (math.isfinite(Y[k]) and math.isfinite(zd_new[k])):
@@ -339,8 +350,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
                                          nbody, zdd_o, gam, v)
             lstats[L_IT_OUT] += max(it_o, 0)
             lam_d[:] = lam_o
-            acceleration_level(Fo, geo_o, zdo, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT,
-                               nbody, zdd_d, gam, v)
+            it_d, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT,
+                                         nbody, zdd_d, gam, v)
+            _count_diag(it_d, lstats)
             finish_diag(zo, zdo, zdd_d, par, arms, contact_power(zo, zdo, ends, fco, work[3], nw), out_d[n_out])
             to_reduced(zo, zdo, yo[2 * nz], nw, yred)
             out_y[n_out, :] = yred
