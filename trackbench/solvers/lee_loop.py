@@ -35,15 +35,13 @@ from ..model.absolute import (applied_forces, constraint_matrix, contact_power, 
                               joint_vectors, phi, to_reduced)
 from ..model.layout import (D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS,
                             S_STATUS, S_STEPS, S_T_FINAL)
-from ..results import CONSTRAINT_ITERATION, MAX_STEPS, NAN, STEP_SIZE_UNDERFLOW, SUCCESSFUL
-from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
+from ..results import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
+from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch
+from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
 from .lee_stages import error_norm, rkn_pass, work_increment
 from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
 
-SAFETY = 0.9
-FAC_MIN = 0.2
-FAC_MAX = 10.0
 # diag's chassis acceleration and the joint forces (output samples, peaks of every accepted step) are those of the
 # state with the multipliers iterated on from the level-4 value to this constraint-acceleration error
 # (m/s^2): 1e-9 / h^2 leaves up to ~20 m/s^2 at h ~ 7e-6 s (up to 0.6 m/s^2 on the chassis
@@ -188,14 +186,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     fac_max = FAC_MAX
     at_switch = False  # the step being tried ends just after a located contact switch
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
-        if steps + rejected >= max_steps:
-            status = MAX_STEPS
+        status, h = before_step(t, h, t_end, steps, rejected, max_steps, h_min)
+        if status != SUCCESSFUL:
             break
-        if h < h_min:
-            status = STEP_SIZE_UNDERFLOW
-            break
-        if t + h > t_end:
-            h = t_end - t
         # ---- 1: position level, re-integrating the step at each iteration
         for m in range(nl):
             lam1[m] = lam0[m]
@@ -239,6 +232,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             rejected += 1
             lstats[L_REJ_ERROR] += 1
             acc_x[X_REJECTED] += 1
+            th = 2.0
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
                 # (solvers/events.py, on the step's ends in reduced coordinates; the last
@@ -249,14 +243,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
                 to_reduced(zd_new, K[ns - 1], 0.0, nw, ev_f1)
                 th = first_contact_switch(ev_y0, ev_f0, ev_y1, ev_f1, h, par, arms, ends, seg, corners, nbr,
                                           ev_pins0, ev_pins1, ev_wheels0, ev_wheels1)
-                at_switch = th < 1.0 and th * h > h_min
-                if at_switch:
-                    h *= th
-                else:
-                    h *= max(FAC_MIN, SAFETY * err ** expo)
-            else:
-                at_switch = False
-                h *= FAC_MIN
+            h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
         t_new = t + h
@@ -375,11 +362,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
         geos[0, :, :] = geos[ns - 1]
         lam0[:] = lam_s
         h_prev = h
-        if err == 0.0:
-            fac = fac_max
-        else:
-            fac = min(fac_max, SAFETY * err ** expo)
-        h = min(h * fac, h_max)
+        h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX
     stats[S_STATUS] = status
     stats[S_T_FINAL] = t

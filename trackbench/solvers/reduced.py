@@ -10,13 +10,11 @@ from numba import njit
 from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, \
     S_STATUS, S_STEPS, S_T_FINAL, Q_X
 from ..model.reduced import reduced_rhs
-from ..results import MAX_STEPS, NAN, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+from ..results import NAN, SUCCESSFUL
+from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch
 from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
 
-SAFETY = 0.9
-FAC_MIN = 0.2
-FAC_MAX = 10.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -114,14 +112,9 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     fac_max = FAC_MAX
     at_switch = False  # the step being tried ends just after a located contact switch
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
-        if steps + rejected >= max_steps:
-            status = MAX_STEPS
+        status, h = before_step(t, h, t_end, steps, rejected, max_steps, h_min)
+        if status != SUCCESSFUL:
             break
-        if h < h_min:
-            status = STEP_SIZE_UNDERFLOW
-            break
-        if t + h > t_end:
-            h = t_end - t
         for i in range(1, s):
             _combine(y, h, A[i], K, i, ys)
             reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, K[i], diag)
@@ -131,18 +124,12 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
         err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, ny - 1, er5, er3)
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
+            th = 2.0
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
                 th = first_contact_switch(y, K[0], y_new, K[s], h, par, arms, ends, seg, corners, nbr,
                                           pins0, pins1, wheels0, wheels1)
-                at_switch = th < 1.0 and th * h > h_min
-                if at_switch:
-                    h *= th
-                else:
-                    h *= max(FAC_MIN, SAFETY * err ** expo)
-            else:
-                at_switch = False
-                h *= FAC_MIN
+            h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
         # accepted
@@ -170,11 +157,7 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
         for k in range(ny):
             y[k] = y_new[k]
             K[0, k] = K[s, k]
-        if err == 0.0:
-            fac = fac_max
-        else:
-            fac = min(fac_max, SAFETY * err ** expo)
-        h = min(h * fac, h_max)
+        h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX
     stats[S_STATUS] = status
     stats[S_T_FINAL] = t

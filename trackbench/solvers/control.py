@@ -1,0 +1,45 @@
+"""Step-size control shared by the compiled time loops (reduced.py, lee_loop.py): the
+standard controller of Hairer, Norsett & Wanner (II.4), plus the retry that ends just
+after a contact switch located in a rejected step (events.py)."""
+
+from numba import njit
+
+from ..results import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+
+SAFETY = 0.9
+FAC_MIN = 0.2
+FAC_MAX = 10.0   # growth after an accepted step (1 right after a rejection)
+
+
+@njit(cache=True, error_model="numpy")
+def before_step(t, h, t_end, steps, rejected, max_steps, h_min):
+    """(status, h): stop on too many attempts or a vanishing step; clip h to t_end."""
+    if steps + rejected >= max_steps:
+        return MAX_STEPS, h
+    if h < h_min:
+        return STEP_SIZE_UNDERFLOW, h
+    if t + h > t_end:
+        h = t_end - t
+    return SUCCESSFUL, h
+
+
+@njit(cache=True, error_model="numpy")
+def after_rejection(h, err, expo, th, h_min):
+    """(h, at_switch) for the retry of a step rejected with error norm err (NaN allowed):
+    end just after the contact switch at fraction th of the step if one was located
+    (th < 1), else the usual shrink."""
+    if err == err and err > 0.0:
+        if th < 1.0 and th * h > h_min:
+            return h * th, True
+        return h * max(FAC_MIN, SAFETY * err ** expo), False
+    return h * FAC_MIN, False
+
+
+@njit(cache=True, error_model="numpy")
+def after_acceptance(h, err, expo, fac_max, h_max):
+    """The next step after an accepted one."""
+    if err == 0.0:
+        fac = fac_max
+    else:
+        fac = min(fac_max, SAFETY * err ** expo)
+    return min(h * fac, h_max)
