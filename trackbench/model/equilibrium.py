@@ -160,7 +160,7 @@ def _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag):
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
     y = np.zeros(2 * nq + 1)
-    for k in range(nq):  # loops, not slice assignments: see solvers/reduced._set_row
+    for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
         y[k] = q[k]
     ydot = np.empty(2 * nq + 1)
     reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag)

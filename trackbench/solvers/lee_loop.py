@@ -36,6 +36,7 @@ from ..model.absolute import (applied_forces, constraint_matrix, contact_power, 
 from ..model.layout import (D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS,
                             S_STATUS, S_STEPS, S_T_FINAL)
 from ..results import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
+from .arrays import copy_2d, copy_into, set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch
 from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
@@ -137,7 +138,7 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     W = from_reduced(y0, par, arms, z, zd)
     applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, Fst[0], fcs[0], diags[0])
     n_rhs += 1
-    fws[0, :, :] = work[3]
+    copy_2d(fws[0], work[3])
     joint_vectors(z, par, arms, geos[0])
     constraint_matrix(geos[0], minv, G)
     eps1 = estimate_eps1(Fst[0], geos[0], zd, minv, lam0, inf_norm(G), n_eps, nbody, zdd, gam, v)
@@ -154,9 +155,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
         status = CONSTRAINT_ITERATION
     for k in range(nbody, nz):
         zdd[k] = Fst[0, k] * minv[k]
-    K[0, :] = zdd
+    set_row(K, 0, zdd)
     p_start = contact_power(z, zd, ends, fcs[0], fws[0], nw)
-    lam_d[:] = lam0
+    copy_into(lam_d, 0, lam0)
     it_d, _ = acceleration_level(Fst[0], geos[0], zd, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT, nbody,
                                  zdd_d, gam, v)
     _count_diag(it_d, lstats)
@@ -167,9 +168,9 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     init_peaks(peaks)
     update_peaks(peaks, 0.0, diags[0], zd[0], W, e_ref, r_ref, False)
     to_reduced(z, zd, W, nw, yred)
-    out_y[0, :] = yred
-    out_d[0, :] = diags[0]
-    out_lam[0, :] = lam_d  # the converged multipliers, as for diag
+    set_row(out_y, 0, yred)
+    set_row(out_d, 0, diags[0])
+    set_row(out_lam, 0, lam_d)  # the converged multipliers, as for diag
     out_x[0, :] = 0.0
     out_x[0, X_ERR_ACC] = err_a
     n_out = 1
@@ -279,21 +280,21 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             zdd_new[k] = Fst[ns - 1, k] * minv[k]
         # contact work and the diagnostics at t + h
         p_end = contact_power(Y, zd_new, ends, fcs[ns - 1], fws[ns - 1], nw)
-        ya[:nz] = z
-        ya[nz:2 * nz] = zd
+        copy_into(ya, 0, z)
+        copy_into(ya, nz, zd)
         ya[2 * nz] = W
-        fa[:nz] = zd
-        fa[nz:2 * nz] = zdd
+        copy_into(fa, 0, zd)
+        copy_into(fa, nz, zdd)
         fa[2 * nz] = p_start
-        yb[:nz] = Y
-        yb[nz:2 * nz] = zd_new
-        fb[:nz] = zd_new
-        fb[nz:2 * nz] = zdd_new
+        copy_into(yb, 0, Y)
+        copy_into(yb, nz, zd_new)
+        copy_into(fb, 0, zd_new)
+        copy_into(fb, nz, zdd_new)
         fb[2 * nz] = p_end
         W_new = W + work_increment(ya, fa, yb, fb, h, bp, c, fcs, fws, ends, nw, p_start, p_end, yo)
         yb[2 * nz] = W_new
         diag = diags[ns - 1]
-        lam_d[:] = lam_s
+        copy_into(lam_d, 0, lam_s)
         it_d, _ = acceleration_level(Fst[ns - 1], geos[ns - 1], zd_new, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL,
                                      DIAG_MAX_IT, nbody, zdd_d, gam, v)
         _count_diag(it_d, lstats)
@@ -336,31 +337,31 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
             it_o, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_o, An, alpha, gn, ptol / (h * h), max_it,
                                          nbody, zdd_o, gam, v)
             lstats[L_IT_OUT] += max(it_o, 0)
-            lam_d[:] = lam_o
+            copy_into(lam_d, 0, lam_o)
             it_d, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT,
                                          nbody, zdd_d, gam, v)
             _count_diag(it_d, lstats)
             finish_diag(zo, zdo, zdd_d, par, arms, contact_power(zo, zdo, ends, fco, work[3], nw), out_d[n_out])
             to_reduced(zo, zdo, yo[2 * nz], nw, yred)
-            out_y[n_out, :] = yred
-            out_lam[n_out, :] = lam_d
-            out_x[n_out, :] = acc_x
+            set_row(out_y, n_out, yred)
+            set_row(out_lam, n_out, lam_d)
+            set_row(out_x, n_out, acc_x)
             acc_x[:] = 0.0
             acc_x[X_H] = h
             n_out += 1
         # ---- shift: the end of this step is the start of the next
         t = t_new
-        z[:] = Y
-        zd[:] = zd_new
-        zdd[:] = zdd_new
+        copy_into(z, 0, Y)
+        copy_into(zd, 0, zd_new)
+        copy_into(zdd, 0, zdd_new)
         W = W_new
         p_start = p_end
-        K[0, :] = zdd_new
-        Fst[0, :] = Fst[ns - 1]
-        fcs[0, :, :] = fcs[ns - 1]
-        fws[0, :, :] = fws[ns - 1]
-        geos[0, :, :] = geos[ns - 1]
-        lam0[:] = lam_s
+        set_row(K, 0, zdd_new)
+        set_row(Fst, 0, Fst[ns - 1])
+        copy_2d(fcs[0], fcs[ns - 1])
+        copy_2d(fws[0], fws[ns - 1])
+        copy_2d(geos[0], geos[ns - 1])
+        copy_into(lam0, 0, lam_s)
         h_prev = h
         h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX

@@ -16,6 +16,7 @@ import math
 from numba import njit
 
 from ..model.absolute import add_phi_qt, applied_forces, contact_power, joint_vectors
+from .arrays import copy_2d
 from .monitor import hermite_second_order
 
 
@@ -37,7 +38,7 @@ def rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corn
                 acc += A[i, j] * K[j, k]
             Y[k] = z[k] + c[i] * h * zd[k] + h * h * acc
         applied_forces(Y, zd, par, arms, ends, seg, corners, nbr, ref, work, Fst[i], fcs[i], diags[i])
-        fws[i, :, :] = fwheel
+        copy_2d(fws[i], fwheel)
         joint_vectors(Y, par, arms, geos[i])
         for m in range(lam_s.shape[0]):
             lam_s[m] = lam0[m] + c[i] * (lam1[m] - lam0[m])

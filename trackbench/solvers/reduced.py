@@ -11,6 +11,7 @@ from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OU
     S_STATUS, S_STEPS, S_T_FINAL, Q_X
 from ..model.reduced import reduced_rhs
 from ..results import NAN, SUCCESSFUL
+from .arrays import set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch
 from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
@@ -29,14 +30,6 @@ def _combine(y, h, w, K, m, out):
         if c != 0.0:
             for k in range(n):
                 out[k] += c * K[j, k]
-
-
-@njit(cache=True, error_model="numpy")
-def _set_row(a, i, v):
-    """a[i, :] = v as a loop: numba's slice assignment compiles its shape-mismatch error
-    message (string formatting), ~4 s of every cold start."""
-    for k in range(v.shape[0]):
-        a[i, k] = v[k]
 
 
 @njit(cache=True, error_model="numpy")
@@ -96,8 +89,8 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
     stats[S_E0] = e_ref - diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
     init_peaks(peaks)
     update_peaks(peaks, 0.0, diag, y[nq + Q_X], y[ny - 1], e_ref, r_ref, False)
-    _set_row(out_y, 0, y)
-    _set_row(out_d, 0, diag)
+    set_row(out_y, 0, y)
+    set_row(out_d, 0, diag)
     n_out = 1
     n_out_max = out_y.shape[0]
     status = SUCCESSFUL
@@ -149,7 +142,7 @@ def integrate(y0, t_end, dt_out, A, b, c, e, e3, expo, rtol, atol, h0, h_max, h_
             t_o = n_out * dt_out
             theta = min(1.0, (t_o - t) / h)
             hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
-            _set_row(out_y, n_out, ys)
+            set_row(out_y, n_out, ys)
             reduced_rhs(ys, par, arms, ends, seg, corners, nbr, ref, work, fs, out_d[n_out])
             n_rhs += 1
             n_out += 1
