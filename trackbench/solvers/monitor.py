@@ -17,6 +17,13 @@ from ..model.layout import (
 STEP_RATIO = 12.0
 
 
+# the quantities tracked from diag besides the wheel forces: peak row, diag slot, +1 for
+# a maximum / -1 for a minimum
+_ROWS = (PK_GROUND_FY, PK_TENSION_MAX, PK_TENSION_MIN, PK_AY_MAX, PK_AY_MIN)
+_SLOTS = (D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_CHASSIS_AY, D_CHASSIS_AY)
+_SIGNS = (1.0, 1.0, -1.0, 1.0, -1.0)
+
+
 @njit(cache=True, error_model="numpy")
 def energy_balance(diag):
     """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
@@ -99,28 +106,15 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
         peaks[PK_FIRST_COMPRESSION, 1] = tc
     # one call site of the inlined _up (each inlined copy costs compile time); a minimum
     # is the maximum of -v, with the row's value and history kept negated meanwhile
-    for j in range(nw + 6):
-        sign = 1.0
+    for j in range(nw + len(_ROWS) + 1):  # wheels, the rows above, chassis vx
         if j < nw:
             k = PK_WHEEL_FY + j
             v = diag[D_WHEEL + 2 * j + 1]
-        elif j == nw:
-            k = PK_GROUND_FY
-            v = diag[D_GROUND_FY]
-        elif j == nw + 1:
-            k = PK_TENSION_MAX
-            v = diag[D_MAX_TENSION]
-        elif j == nw + 2:
-            k = PK_TENSION_MIN
-            v = diag[D_MIN_TENSION]
-            sign = -1.0
-        elif j == nw + 3:
-            k = PK_AY_MAX
-            v = diag[D_CHASSIS_AY]
-        elif j == nw + 4:
-            k = PK_AY_MIN
-            v = diag[D_CHASSIS_AY]
-            sign = -1.0
+            sign = 1.0
+        elif j < nw + len(_ROWS):
+            k = _ROWS[j - nw]
+            v = diag[_SLOTS[j - nw]]
+            sign = _SIGNS[j - nw]
         else:
             k = PK_VX_MIN
             v = vx
