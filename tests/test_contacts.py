@@ -7,7 +7,7 @@ from trackbench.model import layout as L
 from trackbench.model.kernels import allocate_neighbours, track_loads
 from trackbench.model.parameters import pack, paper_track, paper_vehicle
 from trackbench.model.terrain import ground_from_points
-from trackbench.results import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
+from trackbench.status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 
 K = 1e8          # k_w = k_g of the paper
 RHO = 0.30       # wheel radius 0.28 + pad 0.02

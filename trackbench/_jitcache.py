@@ -4,7 +4,7 @@ numba's own cache checks only the source file of each compiled function, not the
 of the functions it calls and inlines: after an upgrade (or a `git pull` on an editable
 install) that changed only `model/kernels.py`, the cached time loop would still hold the
 old contact kernels. So the cache lives in a folder named by a hash of the source of the
-compiled code (model/, solvers/, results.py): ~/.cache/trackbench/numba/<hash>; the last
+compiled code (model/, solvers/, status.py): ~/.cache/trackbench/numba/<hash>; the last
 few folders are kept. Setting NUMBA_CACHE_DIR yourself overrides this.
 """
 
@@ -15,7 +15,7 @@ from pathlib import Path
 
 KEEP = 3
 COMPILED = ("model", "solvers")     # every @njit function lives here
-CONSTANTS = ("results.py",)          # module constants the kernels compile in
+CONSTANTS = ("status.py",)          # module constants the kernels compile in
 
 
 def configure():

@@ -11,7 +11,7 @@ import xarray as xr
 
 from . import __version__
 from .model import layout as L
-from .results import Result
+from .status import Result
 
 MODEL_VERSION = "1"  # bump when a change to the model or solvers changes results
 

@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..results import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
+from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 from .jit import INLINE, KERNEL
 from .layout import (
     D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,

@@ -4,7 +4,7 @@ after a contact switch located in a rejected step (events.py)."""
 
 from numba import njit
 
-from ..results import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+from ..status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
 
 SAFETY = 0.9
 FAC_MIN = 0.2

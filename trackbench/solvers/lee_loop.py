@@ -35,7 +35,7 @@ from ..model.absolute import (applied_forces, constraint_matrix, contact_power, 
                               joint_vectors, phi, to_reduced)
 from ..model.layout import (D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS,
                             S_STATUS, S_STEPS, S_T_FINAL)
-from ..results import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
+from ..status import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
 from .arrays import copy_2d, copy_into, set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch

@@ -10,7 +10,7 @@ from numba import njit
 from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, \
     S_STATUS, S_STEPS, S_T_FINAL, Q_X
 from ..model.reduced import reduced_rhs
-from ..results import NAN, SUCCESSFUL
+from ..status import NAN, SUCCESSFUL
 from .arrays import set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step
 from .events import first_contact_switch
