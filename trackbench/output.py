@@ -131,7 +131,7 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "rhs_evaluations": int(st[L.S_RHS]),
         "min_step": float(st[L.S_H_MIN]),
         "max_step": float(st[L.S_H_MAX]),
-        "neighbour_rebuilds": int(model.nbr[-1, 0]),
+        "neighbour_rebuilds": model.neighbour_rebuilds,
         "wall_time": wall_time,
         "solve_time": solve_time,
         "initial_total_energy": float(e0),

@@ -11,9 +11,8 @@ import numpy as np
 
 from .model import layout as L
 from .model.equilibrium import solve_equilibrium
-from .model.kernels import allocate_neighbours
+from .model.bundles import model_arrays, work_arrays
 from .model.parameters import pack, total_mass
-from .model.reduced import allocate_work
 from .model.terrain import FAR, ground_from_points, obstacle_points
 from .output import build_dataset
 from .scenario import Scenario
@@ -106,19 +105,34 @@ def initial_state(scenario: Scenario, eq):
 
 
 class Model:
-    """The compiled-kernel arrays of one scenario (see model/layout.py)."""
+    """One scenario's vehicle and ground as the compiled kernels take them: the bundles
+    of model/bundles.py, and the sizes and figures the Python side needs."""
 
     def __init__(self, scenario: Scenario, eq, ground):
         v, tr = scenario["vehicle"], scenario["track"]
-        self.par, piv, self.ends = pack(v, tr, scenario["gravity"])
+        par, piv, ends = pack(v, tr, scenario["gravity"])
         self.nw = int(v["n_wheels"])
         self.n_links = int(tr["n_links"])
-        self.arms = np.ascontiguousarray(np.column_stack([piv, eq.phi0]))
-        self.seg = ground.segments
-        self.corners = ground.corners
-        self.nbr, self.ref = allocate_neighbours(self.nw, len(self.corners), self.n_links, len(self.seg))
-        self.work = allocate_work(self.nw, self.n_links)
+        arms = np.column_stack([piv, eq.phi0])
+        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links)
+        self.work = work_arrays(self.nw, self.n_links)
         self.weight = total_mass(v, tr) * scenario["gravity"]
+
+    @property
+    def par(self):
+        return self.arrays.par
+
+    @property
+    def arms(self):
+        return self.arrays.arms
+
+    @property
+    def ends(self):
+        return self.arrays.ends
+
+    @property
+    def neighbour_rebuilds(self):
+        return int(self.arrays.counters[L.C_REBUILDS])
 
 
 def simulate(scenario: Scenario, progress=None):

@@ -14,9 +14,9 @@ from numba import njit
 
 from . import layout as L
 from .jit import KERNEL
-from .kernels import allocate_neighbours
+from .bundles import model_arrays, work_arrays
 from .parameters import equilibrium_arm_angle, pack, total_mass
-from .reduced import allocate_work, reduced_rhs
+from .reduced import reduced_rhs
 from .terrain import flat_ground
 
 
@@ -103,9 +103,8 @@ class _Problem:
         self.phi = equilibrium_arm_angle(vehicle)
         self.arms = np.column_stack([piv, np.full(self.nw, self.phi)])
         g = flat_ground()
-        self.seg, self.corners = g.segments, g.corners
-        self.nbr, self.ref = allocate_neighbours(self.nw, 0, self.n_links, len(self.seg))
-        self.work = allocate_work(self.nw, self.n_links)
+        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links)
+        self.work = work_arrays(self.nw, self.n_links)
         self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
         self.nq = L.n_coordinates(self.nw, self.n_links)
         self.weight = total_mass(vehicle, track) * gravity
@@ -119,8 +118,7 @@ class _Problem:
         return q
 
     def _args(self):
-        return (self.phi, self.par, self.arms, self.ends, self.seg, self.corners, self.nbr,
-                self.ref, self.work, self.diag)
+        return self.phi, self.m, self.work, self.diag
 
     def residual(self, u):
         """(vertical force, moment of chassis + arms, pin forces); horizontal force; arm moments."""
@@ -148,14 +146,12 @@ class _Problem:
         return J
 
     def loads(self, q):
-        apos, avel, fpin, fwheel, wc, wv, lk, arm = self.work
-        _loads_at_rest(q, self.par, self.arms, self.ends, self.seg, self.corners, self.nbr, self.ref,
-                       self.work, self.diag)
-        return apos, fpin, fwheel, wc
+        _loads_at_rest(q, self.m, self.work, self.diag)
+        return self.work.apos, self.work.fpin, self.work.fwheel, self.work.wc
 
 
 @njit(**KERNEL)
-def _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag):
+def _loads_at_rest(q, m, w, diag):
     """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
@@ -163,17 +159,18 @@ def _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag):
     for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
         y[k] = q[k]
     ydot = np.empty(2 * nq + 1)
-    reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, ydot, diag)
+    reduced_rhs(y, m, w, ydot, diag)
 
 
 @njit(**KERNEL)
-def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, arm_moment):
+def _residual(u, phi, m, w, diag, r, arm_moment):
     """Force balance of every free pin, vertical force and moment of chassis + arms
     (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
-    apos, avel, fpin, fwheel, wc, wv, lk, arm = work
+    apos, fpin, fwheel, wc = w.apos, w.fpin, w.fwheel, w.wc
+    par, arms = m.par, m.arms
     nw = arms.shape[0]
     n = apos.shape[0] - 1
-    nq = L.Q_ARM + nw + 2 * (n - 1)
+    nq = L.n_coordinates(nw, n)
     q = np.zeros(nq)
     q[L.Q_Y] = u[0]
     q[L.Q_PITCH] = u[1]
@@ -181,7 +178,7 @@ def _residual(u, phi, par, arms, ends, seg, corners, nbr, ref, work, diag, r, ar
         q[L.Q_ARM + i] = phi  # every arm at the same equilibrium angle
     for k in range(2, u.shape[0]):
         q[L.Q_ARM + nw + k - 2] = u[k]
-    _loads_at_rest(q, par, arms, ends, seg, corners, nbr, ref, work, diag)
+    _loads_at_rest(q, m, w, diag)
     c = math.cos(u[1])
     s = math.sin(u[1])
     g = par[L.P_GRAVITY]

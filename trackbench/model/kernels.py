@@ -1,20 +1,11 @@
 """Compiled track kernels shared by every solver: link tension (Eq. 8), wheel-track
 and ground-track penalty contacts (Eqs. 2-7, Figs. 3-6 and the spec's contact cases),
-and the neighbour lists that keep the contact search away from far-apart pairs.
+and the candidate lists that keep the contact search away from far-apart pairs.
 
-All kernels work on plain arrays (see ``layout``):
-
-    apos, avel (n_links+1, 2)  pin positions / velocities, pins 0 and n_links included
-    wc, wv     (n_wheels, 2)   road-wheel centres / velocities
-    lk         (n_links, 3)    per link: unit direction t (pin b -> b+1) and length
-    fpin       (n_links+1, 2)  out: tension + contact force on each pin
-    fwheel     (n_wheels, 2)   out: contact force of the track on each wheel
-    seg        (n_seg, 7)      ground segments: x0, y0, tx, ty, length, nx, ny (n outward)
-    corners    (n_corners, 2)  convex ground corners
-    nbr        int (rows, 1 + width)  neighbour lists, column 0 holds the count
-    ref        (n_links+1+n_wheels, 2) pin and wheel positions when the lists were built
-
-The inner normal of link b is n = (t_y, -t_x) (towards the road wheels).
+Every kernel takes the bundles of model/bundles.py: ``m`` (ModelArrays: parameters,
+ground, candidate lists), ``w`` (Work: pin and wheel kinematics in, forces out) and
+``diag`` (layout.D_*). The geometry of each contact (which side, which wedge, which
+segment) is model/gaps.py.
 """
 
 import math
@@ -23,11 +14,13 @@ import numpy as np
 from numba import njit
 
 from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
+from .gaps import in_pin_wedge, link_coords, link_frames, pin_ground_selection, pin_segment_acts, segment_coords
 from .jit import INLINE, KERNEL
 from .layout import (
-    D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
-    D_MAX_TENSION, D_MIN_TENSION, D_POWER, D_STATUS, D_WHEEL, P_K_GROUND, P_K_WHEEL,
-    P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS,
+    C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
+    D_MAX_TENSION, D_MIN_TENSION, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND,
+    K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND,
+    P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, diag_tension,
 )
 
 
@@ -46,122 +39,108 @@ def _seg_dist2(px, py, ax, ay, bx, by):
     return dx * dx + dy * dy
 
 
+@njit(**INLINE)
+def _near_links(px, py, apos, reach, nbr, row):
+    """Candidate row: every link whose centre line passes within reach of P."""
+    n = 0
+    for b in range(apos.shape[0] - 1):
+        if _seg_dist2(px, py, apos[b, 0], apos[b, 1], apos[b + 1, 0], apos[b + 1, 1]) < reach * reach:
+            n += 1
+            nbr[row, n] = b
+    nbr[row, NB_COUNT] = n
+
+
+@njit(**INLINE)
+def _near_pins(px, py, apos, reach, nbr, row):
+    """Candidate row: every free pin within reach of P."""
+    n = 0
+    for b in range(1, apos.shape[0] - 1):
+        dx = apos[b, 0] - px
+        dy = apos[b, 1] - py
+        if dx * dx + dy * dy < reach * reach:
+            n += 1
+            nbr[row, n] = b
+    nbr[row, NB_COUNT] = n
+
+
 @njit(**KERNEL)
-def build_neighbours(apos, wc, par, seg, corners, nbr):
+def build_neighbours(apos, wc, m):
     """Fill the candidate lists: every pair that could touch while no pin or wheel
     moves more than half the skin from where it is now."""
-    n_links = apos.shape[0] - 1
-    nw = wc.shape[0]
-    nc = corners.shape[0]
+    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
     skin = par[P_SKIN]
     hg = par[P_PAD_GROUND]
     reach_w = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL] + skin
     reach_cl = max(hg, par[P_PAD_WHEEL]) + skin
-    reach_cp = hg + skin
-    r_wp = nw
-    r_cl = 2 * nw
-    r_cp = r_cl + nc
-    r_ps = r_cp + nc
-    for i in range(nw):
-        px = wc[i, 0]
-        py = wc[i, 1]
-        n = 0
-        for b in range(n_links):
-            if _seg_dist2(px, py, apos[b, 0], apos[b, 1], apos[b + 1, 0], apos[b + 1, 1]) < reach_w * reach_w:
-                n += 1
-                nbr[i, n] = b
-        nbr[i, 0] = n
-        n = 0
-        for b in range(1, n_links):
-            dx = px - apos[b, 0]
-            dy = py - apos[b, 1]
-            if dx * dx + dy * dy < reach_w * reach_w:
-                n += 1
-                nbr[r_wp + i, n] = b
-        nbr[r_wp + i, 0] = n
-    for c in range(nc):
-        px = corners[c, 0]
-        py = corners[c, 1]
-        n = 0
-        for b in range(n_links):
-            if _seg_dist2(px, py, apos[b, 0], apos[b, 1], apos[b + 1, 0], apos[b + 1, 1]) < reach_cl * reach_cl:
-                n += 1
-                nbr[r_cl + c, n] = b
-        nbr[r_cl + c, 0] = n
-        n = 0
-        for b in range(1, n_links):
-            dx = apos[b, 0] - px
-            dy = apos[b, 1] - py
-            if dx * dx + dy * dy < reach_cp * reach_cp:
-                n += 1
-                nbr[r_cp + c, n] = b
-        nbr[r_cp + c, 0] = n
-    for b in range(1, n_links):
+    for i in range(wc.shape[0]):
+        _near_links(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_LINK] + i)
+        _near_pins(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_PIN] + i)
+    for c in range(corners.shape[0]):
+        _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
+        _near_pins(corners[c, 0], corners[c, 1], apos, hg + skin, nbr, rows[K_CORNER_PIN] + c)
+    for b in range(1, apos.shape[0] - 1):
+        row = rows[K_PIN_GROUND] + b
         n = 0
         for j in range(seg.shape[0]):
-            dx = apos[b, 0] - seg[j, 0]
-            dy = apos[b, 1] - seg[j, 1]
-            lam = dx * seg[j, 2] + dy * seg[j, 3]
-            s = dx * seg[j, 5] + dy * seg[j, 6]
-            if lam > -skin and lam < seg[j, 4] + skin and s < hg + skin:
+            lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, j)
+            if lam > -skin and lam < seg[j, SEG_LENGTH] + skin and s < hg + skin:
                 n += 1
-                nbr[r_ps + b, n] = j
-        nbr[r_ps + b, 0] = n
+                nbr[row, n] = j
+        nbr[row, NB_COUNT] = n
 
 
 @njit(**INLINE)
-def refresh_neighbours(apos, wc, par, seg, corners, nbr, ref):
+def _moved(points, ref, first, lim):
+    """Has any point moved more than sqrt(lim) from ref[first + k]?"""
+    stale = False
+    for k in range(points.shape[0]):
+        dx = points[k, 0] - ref[first + k, 0]
+        dy = points[k, 1] - ref[first + k, 1]
+        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
+    return stale
+
+
+@njit(**INLINE)
+def _remember(points, ref, first):
+    for k in range(points.shape[0]):
+        ref[first + k, 0] = points[k, 0]
+        ref[first + k, 1] = points[k, 1]
+
+
+@njit(**INLINE)
+def refresh_neighbours(w, m):
     """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
     (so the lists always hold every pair that can touch: results equal a full search)."""
-    half = 0.5 * par[P_SKIN]
+    half = 0.5 * m.par[P_SKIN]
     lim = half * half
-    n_pins = apos.shape[0]
-    stale = False
-    for b in range(n_pins):
-        dx = apos[b, 0] - ref[b, 0]
-        dy = apos[b, 1] - ref[b, 1]
-        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
-    for i in range(wc.shape[0]):
-        dx = wc[i, 0] - ref[n_pins + i, 0]
-        dy = wc[i, 1] - ref[n_pins + i, 1]
-        stale |= not (dx * dx + dy * dy <= lim)
+    n_pins = w.apos.shape[0]
+    stale = _moved(w.apos, m.ref, 0, lim)
+    stale |= _moved(w.wc, m.ref, n_pins, lim)
     if stale:
-        build_neighbours(apos, wc, par, seg, corners, nbr)
-        for b in range(n_pins):
-            ref[b, 0] = apos[b, 0]
-            ref[b, 1] = apos[b, 1]
-        for i in range(wc.shape[0]):
-            ref[n_pins + i, 0] = wc[i, 0]
-            ref[n_pins + i, 1] = wc[i, 1]
-        nbr[nbr.shape[0] - 1, 0] += 1
+        build_neighbours(w.apos, w.wc, m)
+        _remember(w.apos, m.ref, 0)
+        _remember(w.wc, m.ref, n_pins)
+        m.counters[C_REBUILDS] += 1
 
 
 @njit(**INLINE)
-def link_tensions(apos, par, lk, fpin, diag, t_off):
+def link_tensions(w, par, diag):
     """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; sets fpin to the pull
-    on every pin, stores t and length in lk and T in diag[t_off + b]."""
+    on every pin, stores t and length in lk and T in diag."""
+    apos, lk, fpin = w.apos, w.lk, w.fpin
     k = par[P_LINK_STIFFNESS]
     l0 = par[P_LINK_LENGTH]
+    t_off = diag_tension(w.wc.shape[0])
     fpin[0, 0] = 0.0
     fpin[0, 1] = 0.0
     energy = 0.0
     tmin = np.inf
     tmax = -np.inf
-    n_links = apos.shape[0] - 1
-    for b in range(n_links):  # lengths first: a loop of square roots that vectorises
-        dx = apos[b + 1, 0] - apos[b, 0]
-        dy = apos[b + 1, 1] - apos[b, 1]
-        lk[b, 0] = dx
-        lk[b, 1] = dy
-        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
-    for b in range(n_links):
-        length = lk[b, 2]
-        inv = 1.0 / length
-        tx = lk[b, 0] * inv
-        ty = lk[b, 1] * inv
-        lk[b, 0] = tx
-        lk[b, 1] = ty
-        stretch = length - l0
+    link_frames(apos, lk)
+    for b in range(apos.shape[0] - 1):
+        tx = lk[b, 0]
+        ty = lk[b, 1]
+        stretch = lk[b, 2] - l0
         tension = k * stretch
         diag[t_off + b] = tension
         energy += 0.5 * k * stretch * stretch
@@ -190,66 +169,72 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
 
 
 @njit(**INLINE)
-def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
-    """Road wheel against link (Fig. 3, Eq. 4) and against pin in the wedge (Fig. 4)."""
-    nw = wc.shape[0]
-    k = par[P_K_WHEEL]
-    rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
+def _wheel_on_links(i, w, m, k, rho, diag, acc):
+    """Road wheel i against the links (Fig. 3, Eq. 4). acc = (fx, fy, energy, power) is
+    carried through, not summed apart and added: every sum keeps the order of one loop."""
+    apos, lk, wc = w.apos, w.lk, w.wc
+    fwx, fwy, energy, power = acc
+    row = m.nbr_rows[K_WHEEL_LINK] + i
+    for j in range(m.nbr[row, NB_COUNT]):
+        b = m.nbr[row, 1 + j]
+        d0, s = link_coords(wc[i, 0], wc[i, 1], apos, lk, b)
+        if d0 < 0.0 or d0 > lk[b, 2]:
+            continue
+        if s >= rho or s <= -rho:
+            continue
+        if s < 0.0:
+            diag[D_STATUS] = WHEEL_THROUGH_TRACK
+            continue
+        p = k * (rho - s)  # Eq. (4)
+        fx = p * lk[b, 1]
+        fy = -p * lk[b, 0]
+        fwx += fx
+        fwy += fy
+        energy += 0.5 * k * (rho - s) ** 2
+        power += fx * w.wv[i, 0] + fy * w.wv[i, 1]
+        power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], -fx, -fy)
+    return fwx, fwy, energy, power
+
+
+@njit(**INLINE)
+def _wheel_on_pins(i, w, m, k, rho, acc):
+    """Road wheel i against free pins in the wedge (Fig. 4); acc as in _wheel_on_links."""
+    apos, avel, wc = w.apos, w.avel, w.wc
+    fwx, fwy, energy, power = acc
+    row = m.nbr_rows[K_WHEEL_PIN] + i
+    for j in range(m.nbr[row, NB_COUNT]):
+        b = m.nbr[row, 1 + j]
+        if not in_pin_wedge(wc[i, 0], wc[i, 1], apos, w.lk, b, True):
+            continue
+        dx = wc[i, 0] - apos[b, 0]
+        dy = wc[i, 1] - apos[b, 1]
+        dist = math.sqrt(dx * dx + dy * dy)
+        if dist >= rho:
+            continue
+        p = k * (rho - dist)
+        fx = p * dx / dist
+        fy = p * dy / dist
+        fwx += fx
+        fwy += fy
+        w.fpin[b, 0] -= fx
+        w.fpin[b, 1] -= fy
+        energy += 0.5 * k * (rho - dist) ** 2
+        power += fx * (w.wv[i, 0] - avel[b, 0]) + fy * (w.wv[i, 1] - avel[b, 1])
+    return fwx, fwy, energy, power
+
+
+@njit(**INLINE)
+def wheel_contacts(w, m, diag):
+    """Every road wheel against the track: links, then pins in the wedge."""
+    k = m.par[P_K_WHEEL]
+    rho = m.par[P_WHEEL_RADIUS] + m.par[P_PAD_WHEEL]
     energy = 0.0
     power = 0.0
-    for i in range(nw):
-        fwx = 0.0
-        fwy = 0.0
-        for j in range(nbr[i, 0]):
-            b = nbr[i, 1 + j]
-            tx = lk[b, 0]
-            ty = lk[b, 1]
-            length = lk[b, 2]
-            dx = wc[i, 0] - apos[b, 0]
-            dy = wc[i, 1] - apos[b, 1]
-            d0 = dx * tx + dy * ty
-            if d0 < 0.0 or d0 > length:
-                continue
-            s = dx * ty - dy * tx  # Eq. (2): distance along the inner normal
-            if s >= rho or s <= -rho:
-                continue
-            if s < 0.0:
-                diag[D_STATUS] = WHEEL_THROUGH_TRACK
-                continue
-            p = k * (rho - s)  # Eq. (4)
-            fx = p * ty
-            fy = -p * tx
-            fwx += fx
-            fwy += fy
-            energy += 0.5 * k * (rho - s) ** 2
-            power += fx * wv[i, 0] + fy * wv[i, 1]
-            power += _link_load(fpin, avel, b, d0, length, -fx, -fy)
-        row = nw + i
-        for j in range(nbr[row, 0]):
-            b = nbr[row, 1 + j]
-            dx = wc[i, 0] - apos[b, 0]
-            dy = wc[i, 1] - apos[b, 1]
-            if dx * lk[b, 0] + dy * lk[b, 1] >= 0.0:
-                continue
-            if dx * lk[b - 1, 0] + dy * lk[b - 1, 1] <= 0.0:
-                continue
-            # the bend must be convex towards the wheel (counter-clockwise turn)
-            if lk[b - 1, 0] * lk[b, 1] - lk[b - 1, 1] * lk[b, 0] <= 0.0:
-                continue
-            dist = math.sqrt(dx * dx + dy * dy)
-            if dist >= rho:
-                continue
-            p = k * (rho - dist)
-            fx = p * dx / dist
-            fy = p * dy / dist
-            fwx += fx
-            fwy += fy
-            fpin[b, 0] -= fx
-            fpin[b, 1] -= fy
-            energy += 0.5 * k * (rho - dist) ** 2
-            power += fx * (wv[i, 0] - avel[b, 0]) + fy * (wv[i, 1] - avel[b, 1])
-        fwheel[i, 0] = fwx
-        fwheel[i, 1] = fwy
+    for i in range(w.wc.shape[0]):
+        acc = _wheel_on_links(i, w, m, k, rho, diag, (0.0, 0.0, energy, power))
+        fwx, fwy, energy, power = _wheel_on_pins(i, w, m, k, rho, acc)
+        w.fwheel[i, 0] = fwx
+        w.fwheel[i, 1] = fwy
         diag[D_WHEEL + 2 * i] = fwx
         diag[D_WHEEL + 2 * i + 1] = fwy
     diag[D_E_PAD_WHEEL] = energy
@@ -257,127 +242,105 @@ def wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag):
 
 
 @njit(**INLINE)
-def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
-    """Pin on ground segment (Fig. 5 left, Eq. 6), ground corner on link (Fig. 5 right)
-    and corner on pin in the wedge (Fig. 6)."""
-    n_links = apos.shape[0] - 1
-    nc = corners.shape[0]
-    k = par[P_K_GROUND]
-    hg = par[P_PAD_GROUND]
-    hw = par[P_PAD_WHEEL]
-    rows = nbr.shape[0] - 1  # last row holds counters
-    r_ps = rows - (n_links + 1)
-    r_cp = r_ps - nc
-    r_cl = r_cp - nc
-    energy = 0.0
-    power = 0.0
-    gx = 0.0
-    gy = 0.0
-    corner_force = 0.0
-    for b in range(1, n_links):
-        row = r_ps + b
-        # Is the pin inside the ground (below the surface at its x)? Only then may a
-        # segment it lies behind (s < 0) push it: otherwise the back of an obstacle's
-        # far face (a block's) would push pins on the ground before it from metres away.
-        inside = False
-        n_below = 0
-        best = -np.inf          # largest s over all candidates
-        best_outside = -np.inf  # largest s >= 0
-        for j in range(nbr[row, 0]):
-            sj = nbr[row, 1 + j]
-            dx = apos[b, 0] - seg[sj, 0]
-            dy = apos[b, 1] - seg[sj, 1]
-            s = dx * seg[sj, 5] + dy * seg[sj, 6]
-            if s < 0.0 and seg[sj, 2] > 0.0 and 0.0 <= dx <= seg[sj, 4] * seg[sj, 2]:
-                inside = True  # below a non-vertical segment, within its x-range
-            lam = dx * seg[sj, 2] + dy * seg[sj, 3]
-            if lam < 0.0 or lam > seg[sj, 4] or s >= hg:
-                continue
-            if s < 0.0:
-                n_below += 1
-            else:
-                best_outside = max(best_outside, s)
-            best = max(best, s)
-        if not inside:
-            n_below = 0
-            best = best_outside
+def _pins_on_ground(w, m, k, hg, acc):
+    """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
+    a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
+    energy, power), carried through in the order of one loop."""
+    apos, seg = w.apos, m.seg
+    gx, gy, corner_force, energy, power = acc
+    for b in range(1, apos.shape[0] - 1):
+        row = m.nbr_rows[K_PIN_GROUND] + b
+        inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, m.nbr, row, hg)
         if best == -np.inf:
             continue
-        for j in range(nbr[row, 0]):
-            sj = nbr[row, 1 + j]
-            dx = apos[b, 0] - seg[sj, 0]
-            dy = apos[b, 1] - seg[sj, 1]
-            lam = dx * seg[sj, 2] + dy * seg[sj, 3]
-            if lam < 0.0 or lam > seg[sj, 4]:
-                continue
-            s = dx * seg[sj, 5] + dy * seg[sj, 6]
-            if s >= hg or (s < 0.0 and not inside):
-                continue
-            # a pin beyond several segments presses on the nearest one only
-            if n_below >= 2 and s < best:
+        for j in range(m.nbr[row, NB_COUNT]):
+            sj = m.nbr[row, 1 + j]
+            lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, sj)
+            if not pin_segment_acts(lam, s, seg, sj, hg, inside, n_below, best):
                 continue
             p = k * (hg - s)  # Eq. (6)
-            fx = p * seg[sj, 5]
-            fy = p * seg[sj, 6]
-            fpin[b, 0] += fx
-            fpin[b, 1] += fy
+            fx = p * seg[sj, SEG_NX]
+            fy = p * seg[sj, SEG_NY]
+            w.fpin[b, 0] += fx
+            w.fpin[b, 1] += fy
             gx += fx
             gy += fy
             energy += 0.5 * k * (hg - s) ** 2
-            power += fx * avel[b, 0] + fy * avel[b, 1]
-    for c in range(nc):
-        cx = corners[c, 0]
-        cy = corners[c, 1]
-        row = r_cl + c
-        for j in range(nbr[row, 0]):
-            b = nbr[row, 1 + j]
-            tx = lk[b, 0]
-            ty = lk[b, 1]
-            length = lk[b, 2]
-            dx = cx - apos[b, 0]
-            dy = cy - apos[b, 1]
-            d0 = dx * tx + dy * ty
-            if d0 < 0.0 or d0 > length:
-                continue
-            s = -(dx * ty - dy * tx)  # along the outer normal -n_inner
-            if s >= hg or s <= -hw:
-                continue
-            if s < 0.0:
-                diag[D_STATUS] = CORNER_THROUGH_TRACK
-                continue
-            p = k * (hg - s)
-            fx = p * ty
-            fy = -p * tx
-            gx += fx
-            gy += fy
-            corner_force += p
-            energy += 0.5 * k * (hg - s) ** 2
-            power += _link_load(fpin, avel, b, d0, length, fx, fy)
-        row = r_cp + c
-        for j in range(nbr[row, 0]):
-            b = nbr[row, 1 + j]
-            dx = cx - apos[b, 0]
-            dy = cy - apos[b, 1]
-            if dx * lk[b, 0] + dy * lk[b, 1] >= 0.0:
-                continue
-            if dx * lk[b - 1, 0] + dy * lk[b - 1, 1] <= 0.0:
-                continue
-            # the bend must be convex towards the ground (clockwise turn)
-            if lk[b - 1, 0] * lk[b, 1] - lk[b - 1, 1] * lk[b, 0] >= 0.0:
-                continue
-            dist = math.sqrt(dx * dx + dy * dy)
-            if dist >= hg:
-                continue
-            p = k * (hg - dist)
-            fx = -p * dx / dist
-            fy = -p * dy / dist
-            fpin[b, 0] += fx
-            fpin[b, 1] += fy
-            gx += fx
-            gy += fy
-            corner_force += p
-            energy += 0.5 * k * (hg - dist) ** 2
-            power += fx * avel[b, 0] + fy * avel[b, 1]
+            power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
+    return gx, gy, corner_force, energy, power
+
+
+@njit(**INLINE)
+def _corner_on_links(c, w, m, k, hg, diag, acc):
+    """Ground corner c against the links (Fig. 5 right), split by Eq. (7); acc as above."""
+    apos, lk = w.apos, w.lk
+    cx = m.corners[c, 0]
+    cy = m.corners[c, 1]
+    hw = m.par[P_PAD_WHEEL]
+    gx, gy, corner_force, energy, power = acc
+    row = m.nbr_rows[K_CORNER_LINK] + c
+    for j in range(m.nbr[row, NB_COUNT]):
+        b = m.nbr[row, 1 + j]
+        d0, s_in = link_coords(cx, cy, apos, lk, b)
+        if d0 < 0.0 or d0 > lk[b, 2]:
+            continue
+        s = -s_in  # along the outer normal -n_inner
+        if s >= hg or s <= -hw:
+            continue
+        if s < 0.0:
+            diag[D_STATUS] = CORNER_THROUGH_TRACK
+            continue
+        p = k * (hg - s)
+        fx = p * lk[b, 1]
+        fy = -p * lk[b, 0]
+        gx += fx
+        gy += fy
+        corner_force += p
+        energy += 0.5 * k * (hg - s) ** 2
+        power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], fx, fy)
+    return gx, gy, corner_force, energy, power
+
+
+@njit(**INLINE)
+def _corner_on_pins(c, w, m, k, hg, acc):
+    """Ground corner c against free pins in the wedge (Fig. 6); acc as above."""
+    apos = w.apos
+    cx = m.corners[c, 0]
+    cy = m.corners[c, 1]
+    gx, gy, corner_force, energy, power = acc
+    row = m.nbr_rows[K_CORNER_PIN] + c
+    for j in range(m.nbr[row, NB_COUNT]):
+        b = m.nbr[row, 1 + j]
+        if not in_pin_wedge(cx, cy, apos, w.lk, b, False):
+            continue
+        dx = cx - apos[b, 0]
+        dy = cy - apos[b, 1]
+        dist = math.sqrt(dx * dx + dy * dy)
+        if dist >= hg:
+            continue
+        p = k * (hg - dist)
+        fx = -p * dx / dist
+        fy = -p * dy / dist
+        w.fpin[b, 0] += fx
+        w.fpin[b, 1] += fy
+        gx += fx
+        gy += fy
+        corner_force += p
+        energy += 0.5 * k * (hg - dist) ** 2
+        power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
+    return gx, gy, corner_force, energy, power
+
+
+@njit(**INLINE)
+def ground_contacts(w, m, diag):
+    """The track against the ground: pins on segments, then each corner on links and pins."""
+    k = m.par[P_K_GROUND]
+    hg = m.par[P_PAD_GROUND]
+    acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0))
+    for c in range(m.corners.shape[0]):
+        acc = _corner_on_links(c, w, m, k, hg, diag, acc)
+        acc = _corner_on_pins(c, w, m, k, hg, acc)
+    gx, gy, corner_force, energy, power = acc
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy
@@ -386,24 +349,14 @@ def ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag):
 
 
 @njit(**INLINE)
-def track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off):
-    """All forces of the track model for given pin and wheel positions/velocities
-    (fpin is overwritten, tension first):
-    tension and contact forces on the pins (fpin, pins 0 and n_links included),
-    contact forces on the wheels (fwheel), energies, power and status in diag.
-    Gravity is left to the caller."""
+def track_loads(w, m, diag):
+    """All forces of the track model for the pin and wheel kinematics in w (fpin is
+    overwritten, tension first): tension and contact forces on the pins (w.fpin, pins 0
+    and n_links included), contact forces on the wheels (w.fwheel), energies, power and
+    status in diag. Gravity is left to the caller."""
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
-    refresh_neighbours(apos, wc, par, seg, corners, nbr, ref)
-    link_tensions(apos, par, lk, fpin, diag, t_off)
-    wheel_contacts(apos, avel, wc, wv, lk, par, nbr, fpin, fwheel, diag)
-    ground_contacts(apos, avel, lk, par, seg, corners, nbr, fpin, diag)
-
-
-def allocate_neighbours(n_wheels, n_corners, n_links, n_seg):
-    """Empty neighbour lists (marked stale) for a model of this size."""
-    rows = 2 * n_wheels + 2 * n_corners + (n_links + 1) + 1
-    width = 1 + max(n_links + 1, n_seg)
-    nbr = np.zeros((rows, width), dtype=np.int64)
-    ref = np.full((n_links + 1 + n_wheels, 2), np.nan)
-    return nbr, ref
+    refresh_neighbours(w, m)
+    link_tensions(w, m.par, diag)
+    wheel_contacts(w, m, diag)
+    ground_contacts(w, m, diag)

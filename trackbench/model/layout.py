@@ -14,7 +14,20 @@ Reduced-coordinate state ``y`` (length ``2 * nq + 1``)::
 
 Pins are numbered 0..n_links from the front track end to the rear one; pins 0 and
 n_links are fixed to the chassis. Link b joins pins b and b+1.
+
+Absolute state ``z`` of the "lee" solver (model/absolute.py)::
+
+    z[Z_X], z[Z_Y], z[Z_PITCH]              chassis mass centre and pitch
+    z[z_arm(i) + ZA_X / ZA_Y / ZA_BETA]     arm i: road-wheel centre and absolute arm angle
+    z[z_pin(nw) + 2*(b-1) + k]              free pin b, coordinate k
+
+Everything here is a plain constant or a compiled one-liner, so the kernels read
+``layout.Q_X`` or ``z_arm(i)`` and no kernel writes a bare index into a shared array.
 """
+
+from numba import njit
+
+from .jit import INLINE
 
 # --- generalised coordinates of the reduced solver --------------------------------
 Q_X = 0
@@ -23,14 +36,92 @@ Q_PITCH = 2
 Q_ARM = 3
 
 
+@njit(**INLINE)
 def pin_offset(n_wheels):
     """Index in q of the x coordinate of free pin 1."""
     return Q_ARM + n_wheels
 
 
+@njit(**INLINE)
+def q_pin(n_wheels, b):
+    """Index in q of the x coordinate of free pin b (y is the next one)."""
+    return Q_ARM + n_wheels + 2 * (b - 1)
+
+
+@njit(**INLINE)
 def n_coordinates(n_wheels, n_links):
     return Q_ARM + n_wheels + 2 * (n_links - 1)
 
+
+# --- absolute coordinates of the lee solver ------------------------------------------
+Z_X = 0
+Z_Y = 1
+Z_PITCH = 2
+Z_ARM = 3                # arm i occupies z[Z_ARM + Z_PER_ARM * i : ... + Z_PER_ARM]
+Z_PER_ARM = 3
+ZA_X = 0                 # road-wheel centre x, relative to z_arm(i)
+ZA_Y = 1
+ZA_BETA = 2              # absolute arm angle beta_i = pitch + phi_i
+
+
+@njit(**INLINE)
+def z_arm(i):
+    """Index in z of arm i's first coordinate (its wheel centre x)."""
+    return Z_ARM + Z_PER_ARM * i
+
+
+@njit(**INLINE)
+def z_pin(n_wheels):
+    """Index in z of the x coordinate of free pin 1 (the end of the rigid bodies)."""
+    return Z_ARM + Z_PER_ARM * n_wheels
+
+
+def n_absolute(n_wheels, n_links):
+    return z_pin(n_wheels) + 2 * (n_links - 1)
+
+
+# --- ground segments, ``seg`` (one row per segment of the terrain polyline) --------
+SEG_X0 = 0               # start point
+SEG_Y0 = 1
+SEG_TX = 2               # unit direction (x increasing along the polyline)
+SEG_TY = 3
+SEG_LENGTH = 4
+SEG_NX = 5               # outward unit normal (out of the ground)
+SEG_NY = 6
+N_SEG_COLS = 7
+
+# --- contact pair kinds: the candidate lists hold one block of rows per kind --------
+K_WHEEL_LINK = 0         # row: wheel i; entries: links b          (Fig. 3, Eq. 4)
+K_WHEEL_PIN = 1          # row: wheel i; entries: free pins b      (Fig. 4)
+K_CORNER_LINK = 2        # row: corner c; entries: links b         (Fig. 5 right)
+K_CORNER_PIN = 3         # row: corner c; entries: free pins b     (Fig. 6)
+K_PIN_GROUND = 4         # row: pin b (0..n_links); entries: segments j   (Fig. 5 left, Eq. 6)
+N_KINDS = 5
+
+
+def neighbour_rows(n_wheels, n_corners, n_links):
+    """First row of each kind's block in the candidate lists, and the total row count
+    at [N_KINDS]; the kernels get this as ``nbr_rows``."""
+    counts = [0] * N_KINDS
+    counts[K_WHEEL_LINK] = counts[K_WHEEL_PIN] = n_wheels
+    counts[K_CORNER_LINK] = counts[K_CORNER_PIN] = n_corners
+    counts[K_PIN_GROUND] = n_links + 1
+    starts = [0]
+    for c in counts:
+        starts.append(starts[-1] + c)
+    return starts
+
+
+def neighbour_width(n_links, n_segments):
+    """Columns of a candidate row: the count in column NB_COUNT, then the entries."""
+    return 1 + max(n_links + 1, n_segments)
+
+
+NB_COUNT = 0             # column of the candidate count; entries follow in 1..count
+
+# --- run counters of the model arrays, ``counters`` -----------------------------------
+C_REBUILDS = 0           # candidate-list rebuilds
+N_COUNTERS = 1
 
 # --- scalar parameters, ``par`` ---------------------------------------------------
 P_CHASSIS_MASS = 0
@@ -70,6 +161,7 @@ D_MAX_TENSION = 14
 D_WHEEL = 16             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
+@njit(**INLINE)
 def diag_tension(n_wheels):
     """Offset of the link tensions, one per link, in diag."""
     return D_WHEEL + 2 * n_wheels

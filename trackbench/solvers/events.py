@@ -6,198 +6,151 @@ controller shrinks it. Here the gap (reach - s) of every candidate pair is follo
 the quintic Hermite interpolant of the rejected step (positions only: cheap, and accurate
 because the kink barely disturbs positions), and the first sign change is found by
 bisection, so that the retried step ends right after the kink.
+
+A pair is "valid" where its force law applies (foot on the link or segment, the convex
+wedge, the segment a pin may press on) and in contact where it is valid and its gap is
+positive: the same tests as the force kernels, from model/gaps.py, on points placed by
+model/kinematics.py.
 """
 
 import math
 
+import numpy as np
 from numba import njit
 
-from ..model.layout import P_ARM_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y
+from ..model.gaps import (link_frame, link_frames, pin_ground_selection, pin_segment_valid, point_on_link,
+                          segment_coords, wedge)
+from ..model.jit import INLINE, KERNEL
+from ..model.kinematics import body_offset, place, wheel_offset
+from ..model.layout import (K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS,
+                            NB_COUNT, P_ARM_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
+                            Q_X, Q_Y, q_pin)
+from .hermite import coordinate, quintic_basis
 
 BISECTIONS = 24
 
 
-@njit(cache=True, error_model="numpy")
-def _coord(y0, f0, y1, f1, h, t, k, nq):
-    """Quintic Hermite of coordinate k at t in [0, 1] (same basis as monitor.py)."""
-    t2 = t * t
-    t3 = t2 * t
-    t4 = t3 * t
-    t5 = t4 * t
-    return ((1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5) * y0[k]
-            + h * (t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5) * y0[nq + k]
-            + h * h * (0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5) * f0[nq + k]
-            + (10.0 * t3 - 15.0 * t4 + 6.0 * t5) * y1[k]
-            + h * (-4.0 * t3 + 7.0 * t4 - 3.0 * t5) * y1[nq + k]
-            + h * h * (0.5 * t3 - t4 + 0.5 * t5) * f1[nq + k])
-
-
-@njit(cache=True, error_model="numpy")
-def _pin(b, n_links, y0, f0, y1, f1, h, t, nq, ends):
-    """Position of pin b at t (pins 0 and n_links ride on the chassis)."""
+@njit(**INLINE)
+def _pin_at(b, w, step, nq, m, n_links):
+    """Position of pin b along the step (pins 0 and n_links ride on the chassis)."""
     if b == 0 or b == n_links:
         e = 0 if b == 0 else 1
-        x = _coord(y0, f0, y1, f1, h, t, Q_X, nq)
-        y = _coord(y0, f0, y1, f1, h, t, Q_Y, nq)
-        th = _coord(y0, f0, y1, f1, h, t, Q_PITCH, nq)
-        c = math.cos(th)
-        s = math.sin(th)
-        return x + c * ends[e, 0] - s * ends[e, 1], y + s * ends[e, 0] + c * ends[e, 1]
-    k = nq - 2 * (n_links - 1) + 2 * (b - 1)
-    return _coord(y0, f0, y1, f1, h, t, k, nq), _coord(y0, f0, y1, f1, h, t, k + 1, nq)
+        th = coordinate(w, step, Q_PITCH, nq)
+        rx, ry = body_offset(math.cos(th), math.sin(th), m.ends[e, 0], m.ends[e, 1])
+        return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
+    k = q_pin(m.arms.shape[0], b)
+    return coordinate(w, step, k, nq), coordinate(w, step, k + 1, nq)
 
 
-@njit(cache=True, error_model="numpy")
-def _wheel(i, y0, f0, y1, f1, h, t, nq, par, arms):
-    x = _coord(y0, f0, y1, f1, h, t, Q_X, nq)
-    y = _coord(y0, f0, y1, f1, h, t, Q_Y, nq)
-    th = _coord(y0, f0, y1, f1, h, t, Q_PITCH, nq)
-    beta = th + _coord(y0, f0, y1, f1, h, t, Q_ARM + i, nq)
-    c = math.cos(th)
-    s = math.sin(th)
-    la = par[P_ARM_LENGTH]
-    return (x + c * arms[i, 0] - s * arms[i, 1] + la * math.cos(beta),
-            y + s * arms[i, 0] + c * arms[i, 1] + la * math.sin(beta))
+@njit(**INLINE)
+def _wheel_at(i, w, step, nq, m):
+    th = coordinate(w, step, Q_PITCH, nq)
+    beta = th + coordinate(w, step, Q_ARM + i, nq)
+    rx, ry = wheel_offset(math.cos(th), math.sin(th), m.arms, i, m.par[P_ARM_LENGTH], math.cos(beta),
+                          math.sin(beta))
+    return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
 
 
-@njit(cache=True, error_model="numpy")
-def _pair_gap(kind, px, py, ax, ay, bx, by, cx, cy, reach):
-    """(valid, reach - s) for point P against link A->B (kinds 0, 3) or against pin A in the
-    wedge after the link C->A (kinds 1, 4); see _gap."""
-    ex = bx - ax
-    ey = by - ay
-    length = math.sqrt(ex * ex + ey * ey)
-    tx = ex / length
-    ty = ey / length
-    dx = px - ax
-    dy = py - ay
-    if kind == 0 or kind == 3:
-        d0 = dx * tx + dy * ty
-        s = dx * ty - dy * tx
-        if kind == 3:
-            s = -s
+@njit(**INLINE)
+def _reach(kind, par):
+    if kind == K_WHEEL_LINK or kind == K_WHEEL_PIN:
+        return par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
+    return par[P_PAD_GROUND]
+
+
+@njit(**INLINE)
+def _pair(kind, p, a, bb, c, reach):
+    """(valid, reach - s) of point p against the link a -> bb (link kinds) or against pin a
+    in the wedge after the link c -> a (pin kinds); points are (x, y) tuples."""
+    tx, ty, length = link_frame(a[0], a[1], bb[0], bb[1])
+    if kind == K_WHEEL_LINK or kind == K_CORNER_LINK:
+        d0, s = point_on_link(p[0], p[1], a[0], a[1], tx, ty)
+        if kind == K_CORNER_LINK:
+            s = -s  # a corner is measured along the outer normal
         return 0.0 <= d0 <= length and s > 0.0, reach - s
-    ux = ax - cx
-    uy = ay - cy
-    cross = ux * ty - uy * tx
-    wedge = dx * tx + dy * ty < 0.0 and dx * ux + dy * uy > 0.0
-    convex = cross > 0.0 if kind == 1 else cross < 0.0
-    return wedge and convex, reach - math.sqrt(dx * dx + dy * dy)
+    ux, uy, _ = link_frame(c[0], c[1], a[0], a[1])
+    dx = p[0] - a[0]
+    dy = p[1] - a[1]
+    return wedge(p[0], p[1], a[0], a[1], ux, uy, tx, ty, kind == K_WHEEL_PIN), reach - math.sqrt(dx * dx + dy * dy)
 
 
-@njit(cache=True, error_model="numpy")
-def _seg_gap(px, py, seg, j, hg):
-    dx = px - seg[j, 0]
-    dy = py - seg[j, 1]
-    lam = dx * seg[j, 2] + dy * seg[j, 3]
-    s = dx * seg[j, 5] + dy * seg[j, 6]
-    return 0.0 <= lam <= seg[j, 4] and s > 0.0, hg - s
+@njit(**INLINE)
+def _pin_ground(px, py, sj, m, row):
+    """(valid, h_g - s) of a pin at P on segment sj, by the kernel's selection rule."""
+    hg = m.par[P_PAD_GROUND]
+    inside, n_below, best = pin_ground_selection(px, py, m.seg, m.nbr, row, hg)
+    lam, s, _ = segment_coords(px, py, m.seg, sj)
+    return pin_segment_valid(lam, s, m.seg, sj, inside, n_below, best), hg - s
 
 
-@njit(cache=True, error_model="numpy")
-def _gap(kind, i, b, t, y0, f0, y1, f1, h, nq, n_links, par, arms, ends, seg, corners):
-    """(valid, reach - s) of one candidate pair at t along the interpolant: kind 0
-    wheel-link, 1 wheel-pin, 2 pin-segment (i = segment), 3 corner-link, 4 corner-pin
-    (i = corner); valid = foot on the link / segment, or in the convex wedge."""
-    if kind == 2:
-        px, py = _pin(b, n_links, y0, f0, y1, f1, h, t, nq, ends)
-        return _seg_gap(px, py, seg, i, par[P_PAD_GROUND])
-    if kind == 0 or kind == 1:
-        px, py = _wheel(i, y0, f0, y1, f1, h, t, nq, par, arms)
-        reach = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
+@njit(**INLINE)
+def _gap_at(kind, i, b, t, step, nq, m, n_links):
+    """(valid, gap) of one candidate pair at fraction t of the step: kind K_*, i the wheel
+    or corner (the pin for K_PIN_GROUND), b the link or pin (the segment for K_PIN_GROUND)."""
+    w = quintic_basis(t)
+    if kind == K_PIN_GROUND:
+        px, py = _pin_at(i, w, step, nq, m, n_links)
+        return _pin_ground(px, py, b, m, m.nbr_rows[K_PIN_GROUND] + i)
+    if kind == K_WHEEL_LINK or kind == K_WHEEL_PIN:
+        p = _wheel_at(i, w, step, nq, m)
     else:
-        px = corners[i, 0]
-        py = corners[i, 1]
-        reach = par[P_PAD_GROUND]
-    ax, ay = _pin(b, n_links, y0, f0, y1, f1, h, t, nq, ends)
-    bx, by = _pin(b + 1, n_links, y0, f0, y1, f1, h, t, nq, ends)
-    cx, cy = ax, ay
-    if kind == 1 or kind == 4:
-        cx, cy = _pin(b - 1, n_links, y0, f0, y1, f1, h, t, nq, ends)
-    return _pair_gap(kind, px, py, ax, ay, bx, by, cx, cy, reach)
+        p = (m.corners[i, 0], m.corners[i, 1])
+    a = _pin_at(b, w, step, nq, m, n_links)
+    bb = _pin_at(b + 1, w, step, nq, m, n_links)
+    c = a
+    if kind == K_WHEEL_PIN or kind == K_CORNER_PIN:
+        c = _pin_at(b - 1, w, step, nq, m, n_links)
+    return _pair(kind, p, a, bb, c, _reach(kind, m.par))
 
 
-@njit(cache=True, error_model="numpy")
-def _points(y, nq, par, arms, ends, pins, wheels):
-    """Pin and wheel-centre positions of state y (the ends of the step)."""
-    n_links = pins.shape[0] - 1
-    c = math.cos(y[Q_PITCH])
-    s = math.sin(y[Q_PITCH])
-    la = par[P_ARM_LENGTH]
-    for e in range(2):
-        b = 0 if e == 0 else n_links
-        pins[b, 0] = y[Q_X] + c * ends[e, 0] - s * ends[e, 1]
-        pins[b, 1] = y[Q_Y] + s * ends[e, 0] + c * ends[e, 1]
-    off = nq - 2 * (n_links - 1)
-    for b in range(1, n_links):
-        pins[b, 0] = y[off + 2 * (b - 1)]
-        pins[b, 1] = y[off + 2 * (b - 1) + 1]
-    for i in range(arms.shape[0]):
-        beta = y[Q_PITCH] + y[Q_ARM + i]
-        wheels[i, 0] = y[Q_X] + c * arms[i, 0] - s * arms[i, 1] + la * math.cos(beta)
-        wheels[i, 1] = y[Q_Y] + s * arms[i, 0] + c * arms[i, 1] + la * math.sin(beta)
-
-
-@njit(cache=True, error_model="numpy")
-def _end_gap(kind, sg, b, pins, wheels, par, seg, corners):
-    """_gap at an end of the step, from precomputed points."""
-    if kind == 2:
-        return _seg_gap(pins[b, 0], pins[b, 1], seg, sg, par[P_PAD_GROUND])
-    if kind == 0 or kind == 1:
-        px = wheels[sg, 0]
-        py = wheels[sg, 1]
-        reach = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
+@njit(**INLINE)
+def _gap_end(kind, i, b, pins, wheels, m):
+    """_gap_at at an end of the step, from the points placed there."""
+    if kind == K_PIN_GROUND:
+        return _pin_ground(pins[i, 0], pins[i, 1], b, m, m.nbr_rows[K_PIN_GROUND] + i)
+    if kind == K_WHEEL_LINK or kind == K_WHEEL_PIN:
+        p = (wheels[i, 0], wheels[i, 1])
     else:
-        px = corners[sg, 0]
-        py = corners[sg, 1]
-        reach = par[P_PAD_GROUND]
-    bp = b - 1 if (kind == 1 or kind == 4) else b
-    return _pair_gap(kind, px, py, pins[b, 0], pins[b, 1], pins[b + 1, 0], pins[b + 1, 1],
-                     pins[bp, 0], pins[bp, 1], reach)
+        p = (m.corners[i, 0], m.corners[i, 1])
+    bp = b - 1 if (kind == K_WHEEL_PIN or kind == K_CORNER_PIN) else b
+    return _pair(kind, p, (pins[b, 0], pins[b, 1]), (pins[b + 1, 0], pins[b + 1, 1]), (pins[bp, 0], pins[bp, 1]),
+                 _reach(kind, m.par))
 
 
-@njit(cache=True, error_model="numpy")
-def first_contact_switch(y0, f0, y1, f1, h, par, arms, ends, seg, corners, nbr, pins0, pins1, wheels0, wheels1):
-    """Smallest t in (0, 1] at which some candidate contact starts or ends along the
-    step's interpolant (the upper end of the bisection bracket: just after the kink);
-    2.0 if none. Pairs whose validity (foot on link, wedge) changes are left alone.
-    pins0/1, wheels0/1: scratch for the positions at both ends of the step."""
-    nq = (y0.shape[0] - 1) // 2
-    _points(y0, nq, par, arms, ends, pins0, wheels0)
-    _points(y1, nq, par, arms, ends, pins1, wheels1)
-    nw = arms.shape[0]
-    nc = corners.shape[0]
-    n_links = nbr.shape[0] - 1 - 2 * nw - 2 * nc - 1
-    best = 2.0
-    for row in range(nbr.shape[0] - 1):
-        if row < nw:
-            kind, i = 0, row
-        elif row < 2 * nw:
-            kind, i = 1, row - nw
-        elif row < 2 * nw + nc:
-            kind, i = 3, row - 2 * nw
-        elif row < 2 * nw + 2 * nc:
-            kind, i = 4, row - 2 * nw - nc
+@njit(**INLINE)
+def _bisect(kind, i, b, g0, step, nq, m, n_links):
+    """Upper end of the bracket of the gap's sign change (just after the kink)."""
+    lo = 0.0
+    hi = 1.0
+    for _ in range(BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        _, gm = _gap_at(kind, i, b, mid, step, nq, m, n_links)
+        if (gm > 0.0) == (g0 > 0.0):
+            lo = mid
         else:
-            kind, i = 2, row - 2 * nw - 2 * nc  # i = pin here
-        for j in range(nbr[row, 0]):
-            other = nbr[row, 1 + j]
-            if kind == 2:
-                b, sg = i, other
-            else:
-                b, sg = other, i
-            v0, g0 = _end_gap(kind, sg, b, pins0, wheels0, par, seg, corners)
-            v1, g1 = _end_gap(kind, sg, b, pins1, wheels1, par, seg, corners)
-            if not (v0 and v1) or (g0 > 0.0) == (g1 > 0.0):
-                continue
-            lo = 0.0
-            hi = 1.0
-            for _ in range(BISECTIONS):
-                mid = 0.5 * (lo + hi)
-                _, gm = _gap(kind, sg, b, mid, y0, f0, y1, f1, h, nq, n_links, par, arms, ends, seg, corners)
-                if (gm > 0.0) == (g0 > 0.0):
-                    lo = mid
-                else:
-                    hi = mid
-            best = min(best, hi)
+            hi = mid
+    return hi
+
+
+@njit(**KERNEL)
+def first_contact_switch(y0, f0, y1, f1, h, m, ev):
+    """Smallest t in (0, 1] at which some candidate contact starts or ends along the
+    step's interpolant; 2.0 if none. Pairs whose validity (foot on link, wedge, acting
+    segment) changes are left alone. ev: EventWork scratch."""
+    nq = (y0.shape[0] - 1) // 2
+    n_links = ev.pins0.shape[0] - 1
+    place(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm)
+    place(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm)
+    step = (y0, f0, y1, f1, h)
+    best = 2.0
+    for kind in range(N_KINDS):
+        for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
+            i = row - m.nbr_rows[kind]
+            for j in range(m.nbr[row, NB_COUNT]):
+                b = m.nbr[row, 1 + j]
+                v0, g0 = _gap_end(kind, i, b, ev.pins0, ev.wheels0, m)
+                v1, g1 = _gap_end(kind, i, b, ev.pins1, ev.wheels1, m)
+                if not (v0 and v1) or (g0 > 0.0) == (g1 > 0.0):
+                    continue
+                best = min(best, _bisect(kind, i, b, g0, step, nq, m, n_links))
     return best

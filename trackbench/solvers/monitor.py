@@ -1,8 +1,10 @@
-"""What every solver does at an accepted step: update the peaks (so no impulse between
-output samples is missed) and fill output samples by Hermite interpolation."""
+"""What every solver does at an accepted step: update the peaks, so that no impulse
+between output samples is missed."""
 
 import numpy as np
 from numba import njit
+
+from ..model.jit import INLINE, KERNEL
 
 from ..model.layout import (
     D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
@@ -24,20 +26,20 @@ _SLOTS = (D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_CHASSIS_AY, D_CHASSIS_AY)
 _SIGNS = (1.0, 1.0, -1.0, 1.0, -1.0)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def energy_balance(diag):
     """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
     return (diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_PAD_WHEEL]
             + diag[D_E_PAD_GROUND] + diag[D_E_GRAVITY])
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def energy_residual(diag, work):
     """Kinetic + torsion + tension + gravity - work of the contact forces (continuous)."""
     return diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_GRAVITY] - work
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def init_peaks(peaks):
     peaks[:, 0] = -np.inf
     peaks[:, 1] = np.nan
@@ -52,14 +54,14 @@ def init_peaks(peaks):
     peaks[PK_SWITCH, :] = -1.0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(**INLINE)
 def _max(peaks, k, v, t):
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(**INLINE)
 def _up(peaks, k, v, t, t_switch):
     """Running maximum of a quantity sampled at every accepted step. A local maximum at
     the previous step is refined by the parabola through the last three samples, so a
@@ -89,7 +91,7 @@ def _up(peaks, k, v, t, t_switch):
     peaks[k, 5] = t
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
     shortened to end just after a located contact switch (solvers/events.py)."""
@@ -129,41 +131,3 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
         peaks[PK_FIRST_CORNER, 1] = t
     if at_switch:
         peaks[PK_SWITCH, 1] = t
-
-
-@njit(cache=True, error_model="numpy")
-def hermite_second_order(y0, f0, y1, f1, h, theta, nq, out):
-    """State at t0 + theta h from (q, qd, qdd) at both ends of a step of a second-order
-    system stored as y = (q, qd, extra): quintic Hermite for q, its derivative for qd,
-    cubic Hermite for the extra first-order components."""
-    t = theta
-    t2 = t * t
-    t3 = t2 * t
-    t4 = t3 * t
-    t5 = t4 * t
-    h00 = 1.0 - 10.0 * t3 + 15.0 * t4 - 6.0 * t5
-    h10 = t - 6.0 * t3 + 8.0 * t4 - 3.0 * t5
-    h20 = 0.5 * t2 - 1.5 * t3 + 1.5 * t4 - 0.5 * t5
-    h01 = 10.0 * t3 - 15.0 * t4 + 6.0 * t5
-    h11 = -4.0 * t3 + 7.0 * t4 - 3.0 * t5
-    h21 = 0.5 * t3 - t4 + 0.5 * t5
-    d00 = (-30.0 * t2 + 60.0 * t3 - 30.0 * t4) / h
-    d10 = 1.0 - 18.0 * t2 + 32.0 * t3 - 15.0 * t4
-    d20 = h * (t - 4.5 * t2 + 6.0 * t3 - 2.5 * t4)
-    d11 = -12.0 * t2 + 28.0 * t3 - 15.0 * t4
-    d21 = h * (1.5 * t2 - 4.0 * t3 + 2.5 * t4)
-    for k in range(nq):
-        q0 = y0[k]
-        v0 = y0[nq + k]
-        a0 = f0[nq + k]
-        q1 = y1[k]
-        v1 = y1[nq + k]
-        a1 = f1[nq + k]
-        out[k] = h00 * q0 + h * h10 * v0 + h * h * h20 * a0 + h01 * q1 + h * h11 * v1 + h * h * h21 * a1
-        out[nq + k] = d00 * q0 + d10 * v0 + d20 * a0 - d00 * q1 + d11 * v1 + d21 * a1
-    c00 = 2.0 * t3 - 3.0 * t2 + 1.0
-    c10 = t3 - 2.0 * t2 + t
-    c01 = -2.0 * t3 + 3.0 * t2
-    c11 = t3 - t2
-    for k in range(2 * nq, y0.shape[0]):
-        out[k] = c00 * y0[k] + h * c10 * f0[k] + c01 * y1[k] + h * c11 * f1[k]

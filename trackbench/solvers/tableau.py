@@ -5,11 +5,16 @@ f(t + h, y_new) (first same as last), and ``e`` weights that extended list.
 DOP853 combines a 5th- and a 3rd-order estimate (Hairer et al., eq. II.10.14).
 """
 
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import coefficients as K
+
+
+# What the compiled stepper reads: numba takes the named tuple as one argument.
+TableauArrays = namedtuple("TableauArrays", ["A", "b", "c", "e", "e3", "expo"])
 
 
 def lower_triangular(rows):
@@ -49,9 +54,10 @@ class ButcherTableau:
         return len(self.c)
 
     def arrays(self):
-        """(A, b, c, e, e3, error exponent) as float arrays for the compiled stepper."""
+        """TableauArrays (A, b, c, e, e3, error exponent) for the compiled stepper."""
         e3 = np.array(self.e3 if self.e3 else np.zeros(self.stages + 1))
-        return lower_triangular(self.a), np.array(self.b), np.array(self.c), np.array(self.e), e3, -1.0 / (self.error_order + 1)
+        return TableauArrays(lower_triangular(self.a), np.array(self.b), np.array(self.c), np.array(self.e), e3,
+                             -1.0 / (self.error_order + 1))
 
 
 DOP853 = ButcherTableau("dop853", 8, 7, tuple(K.DOP853_C), tuple(map(tuple, K.DOP853_A)),

@@ -1,0 +1,71 @@
+"""The arrays the compiled kernels share, bundled as named tuples: numba passes a bundle
+as one argument and reads its fields at no cost, so a kernel takes a few bundles rather
+than thirty arrays. The Python side allocates and fills them once per run (``allocate_*``);
+the kernels never allocate. What each array holds: model/layout.py."""
+
+from collections import namedtuple
+
+import numpy as np
+
+from . import layout as L
+
+# Fixed for a run, except the candidate lists (nbr, ref), which the contact search
+# refreshes as the track moves, and the counters.
+ModelArrays = namedtuple("ModelArrays", [
+    "par",        # (N_PAR,) scalar parameters, P_*
+    "arms",       # (n_wheels, 3) arm pivot body point (x, y) and torsion-bar free angle phi0
+    "ends",       # (2, 2) track-end body points: front (pin 0), rear (pin n_links)
+    "seg",        # (n_segments, N_SEG_COLS) ground segments, SEG_*
+    "corners",    # (n_corners, 2) convex ground corners
+    "nbr",        # int (rows, width) candidate lists: count in NB_COUNT, entries after it
+    "nbr_rows",   # int (N_KINDS + 1,) first row of each pair kind's block in nbr, K_*
+    "ref",        # (n_pins + n_wheels, 2) pin and wheel positions when nbr was built
+    "counters",   # int (N_COUNTERS,) C_*
+])
+
+# Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
+# forces out (model/kernels.py track_loads).
+Work = namedtuple("Work", [
+    "apos",       # (n_pins, 2) pin positions, track ends included
+    "avel",       # (n_pins, 2) pin velocities
+    "fpin",       # (n_pins, 2) out: tension + contact force on each pin
+    "wc",         # (n_wheels, 2) road-wheel centres
+    "wv",         # (n_wheels, 2) road-wheel centre velocities
+    "fwheel",     # (n_wheels, 2) out: contact force of the track on each wheel
+    "lk",         # (n_links, 3) per link: unit direction t (pin b -> b+1) and length
+    "arm",        # (n_wheels, ARM_COLS) per arm: cos and sin of beta, the chassis coupling
+])
+
+ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
+ARM_COLS = 6
+
+
+def model_arrays(par, arms, ends, seg, corners, n_links):
+    """The bundle, with empty candidate lists (marked stale: built at the first use)."""
+    n_wheels = arms.shape[0]
+    rows = L.neighbour_rows(n_wheels, corners.shape[0], n_links)
+    nbr = np.zeros((rows[L.N_KINDS], L.neighbour_width(n_links, seg.shape[0])), dtype=np.int64)
+    ref = np.full((n_links + 1 + n_wheels, 2), np.nan)
+    return ModelArrays(np.ascontiguousarray(par, dtype=float), np.ascontiguousarray(arms, dtype=float),
+                       np.ascontiguousarray(ends, dtype=float), np.ascontiguousarray(seg, dtype=float),
+                       np.ascontiguousarray(corners, dtype=float).reshape(-1, 2), nbr,
+                       np.array(rows, dtype=np.int64), ref, np.zeros(L.N_COUNTERS, dtype=np.int64))
+
+
+def work_arrays(n_wheels, n_links):
+    n_pins = n_links + 1
+    return Work(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
+                np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
+                np.zeros((n_links, 3)), np.zeros((n_wheels, ARM_COLS)))
+
+
+# Scratch of the event location (solvers/events.py): the configuration at both ends of
+# a rejected step.
+EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "lk0", "lk1", "arm"])
+
+
+def event_arrays(n_wheels, n_links):
+    n_pins = n_links + 1
+    return EventWork(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_wheels, 2)),
+                     np.zeros((n_wheels, 2)), np.zeros((n_links, 3)), np.zeros((n_links, 3)),
+                     np.zeros((n_wheels, ARM_COLS)))

@@ -1,0 +1,136 @@
+"""Contact geometry, written once: where a point lies relative to a link, a pin's wedge or
+a ground segment, and which ground segment a pin presses on. The force kernels
+(kernels.py) and the event location (solvers/events.py) both decide "in contact or not"
+through these functions, so a located onset is an onset of the force law.
+
+Conventions (model.md): link b runs from pin b to pin b+1 with unit direction t and
+length l (Work.lk); its inner normal (towards the road wheels) is (t_y, -t_x).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .jit import INLINE
+from .layout import NB_COUNT, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0
+
+
+@njit(**INLINE)
+def link_frames(apos, lk):
+    """Unit direction and length of every link into lk (lengths first: a loop of square
+    roots that vectorises)."""
+    n_links = apos.shape[0] - 1
+    for b in range(n_links):
+        dx = apos[b + 1, 0] - apos[b, 0]
+        dy = apos[b + 1, 1] - apos[b, 1]
+        lk[b, 0] = dx
+        lk[b, 1] = dy
+        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
+    for b in range(n_links):
+        inv = 1.0 / lk[b, 2]
+        lk[b, 0] = lk[b, 0] * inv
+        lk[b, 1] = lk[b, 1] * inv
+
+
+@njit(**INLINE)
+def link_frame(ax, ay, bx, by):
+    """(tx, ty, length) of the link from pin A to pin B, rounded as link_frames does."""
+    dx = bx - ax
+    dy = by - ay
+    length = math.sqrt(dx * dx + dy * dy)
+    inv = 1.0 / length
+    return dx * inv, dy * inv, length
+
+
+@njit(**INLINE)
+def point_on_link(px, py, ax, ay, tx, ty):
+    """(d0, s) of point P against the link from pin A along t: d0 along the link (the foot
+    lies on the link when 0 <= d0 <= length), s the distance along the inner normal, Eq. (2)."""
+    dx = px - ax
+    dy = py - ay
+    return dx * tx + dy * ty, dx * ty - dy * tx
+
+
+@njit(**INLINE)
+def link_coords(px, py, apos, lk, b):
+    """point_on_link for link b of the track (lk from link_frames)."""
+    return point_on_link(px, py, apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
+
+
+@njit(**INLINE)
+def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
+    """P lies in the wedge beyond the free pin A between a link along t0 (ending at A) and
+    one along t1 (starting at A) - both fail the foot test - on the convex side of the
+    bend: convex towards the inner side (a road wheel) when towards_inner, towards the
+    ground otherwise (Figs. 4 and 6)."""
+    dx = px - ax
+    dy = py - ay
+    if dx * t1x + dy * t1y >= 0.0:
+        return False
+    if dx * t0x + dy * t0y <= 0.0:
+        return False
+    turn = t0x * t1y - t0y * t1x  # > 0: counter-clockwise bend
+    return turn > 0.0 if towards_inner else turn < 0.0
+
+
+@njit(**INLINE)
+def in_pin_wedge(px, py, apos, lk, b, towards_inner):
+    """wedge at free pin b of the track."""
+    return wedge(px, py, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1], towards_inner)
+
+
+@njit(**INLINE)
+def segment_coords(px, py, seg, j):
+    """(lam, s) of point P against ground segment j: lam along it from its start (the
+    foot lies on it when 0 <= lam <= length), s along its outward normal, and dx (P's x
+    from the segment start) for the inside-the-ground test."""
+    dx = px - seg[j, SEG_X0]
+    dy = py - seg[j, SEG_Y0]
+    return dx * seg[j, SEG_TX] + dy * seg[j, SEG_TY], dx * seg[j, SEG_NX] + dy * seg[j, SEG_NY], dx
+
+
+@njit(**INLINE)
+def pin_ground_selection(px, py, seg, nbr, row, hg):
+    """Which of a pin's candidate segments may push it (model.md): (inside, n_below, best).
+    inside: the pin is below a non-vertical segment within its x-range, i.e. inside the
+    ground; only then may a segment it lies behind (s < 0) push it, otherwise the back of
+    an obstacle's far face would push pins on the ground before it from metres away.
+    n_below: segments it is behind; best: the largest s among the acting candidates (a pin
+    beyond several segments presses on the nearest one only); -inf when none acts."""
+    inside = False
+    n_below = 0
+    best = -np.inf
+    best_outside = -np.inf
+    for j in range(nbr[row, NB_COUNT]):
+        sj = nbr[row, 1 + j]
+        lam, s, dx = segment_coords(px, py, seg, sj)
+        if s < 0.0 and seg[sj, SEG_TX] > 0.0 and 0.0 <= dx <= seg[sj, SEG_LENGTH] * seg[sj, SEG_TX]:
+            inside = True
+        if lam < 0.0 or lam > seg[sj, SEG_LENGTH] or s >= hg:
+            continue
+        if s < 0.0:
+            n_below += 1
+        else:
+            best_outside = max(best_outside, s)
+        best = max(best, s)
+    if not inside:
+        return False, 0, best_outside
+    return True, n_below, best
+
+
+@njit(**INLINE)
+def pin_segment_valid(lam, s, seg, sj, inside, n_below, best):
+    """May segment sj push the pin (foot on it, on the right side, the nearest of several
+    it is behind)? It does when also s < h_g; h_g - s is then the pad compression."""
+    if lam < 0.0 or lam > seg[sj, SEG_LENGTH]:
+        return False
+    if s < 0.0 and not inside:
+        return False
+    return not (n_below >= 2 and s < best)
+
+
+@njit(**INLINE)
+def pin_segment_acts(lam, s, seg, sj, hg, inside, n_below, best):
+    """Does segment sj push the pin (pin_segment_valid and within the pad)?"""
+    return s < hg and pin_segment_valid(lam, s, seg, sj, inside, n_below, best)

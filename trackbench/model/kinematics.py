@@ -1,0 +1,91 @@
+"""Kinematics, written once: chassis pitch and arm angles -> road-wheel centres, track
+ends and their velocities. The right-hand sides, the event location and the output all
+place the wheels and pins through these functions, so they agree to the last bit."""
+
+import math
+
+from numba import njit
+
+from .bundles import ARM_COS, ARM_SIN
+from .jit import INLINE
+from .layout import P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y, q_pin
+
+
+@njit(**INLINE)
+def body_offset(c, s, bx, by):
+    """R(theta) (bx, by): a body point relative to the chassis mass centre, in the world."""
+    return c * bx - s * by, s * bx + c * by
+
+
+@njit(**INLINE)
+def wheel_offset(c, s, arms, i, la, cb, sb):
+    """Road-wheel centre of arm i relative to the chassis mass centre: pivot + l e_i,
+    e_i = (cos beta_i, sin beta_i), beta_i = pitch + phi_i."""
+    px, py = body_offset(c, s, arms[i, 0], arms[i, 1])
+    return px + la * cb, py + la * sb
+
+
+@njit(**INLINE)
+def end_pin(b, n_links):
+    """Which track end pin b is (0 front, 1 rear), or -1 for a free pin."""
+    if b == 0:
+        return 0
+    if b == n_links:
+        return 1
+    return -1
+
+
+@njit(**INLINE)
+def place(q, m, apos, wc, arm):
+    """Pin and wheel-centre positions of configuration q into apos and wc; cos and sin of
+    each arm's absolute angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
+    nw = m.arms.shape[0]
+    n_links = apos.shape[0] - 1
+    c = math.cos(q[Q_PITCH])
+    s = math.sin(q[Q_PITCH])
+    la = m.par[P_ARM_LENGTH]
+    for i in range(nw):
+        beta = q[Q_PITCH] + q[Q_ARM + i]
+        cb = math.cos(beta)
+        sb = math.sin(beta)
+        arm[i, ARM_COS] = cb
+        arm[i, ARM_SIN] = sb
+        rx, ry = wheel_offset(c, s, m.arms, i, la, cb, sb)
+        wc[i, 0] = q[Q_X] + rx
+        wc[i, 1] = q[Q_Y] + ry
+    for e in range(2):
+        b = 0 if e == 0 else n_links
+        rx, ry = body_offset(c, s, m.ends[e, 0], m.ends[e, 1])
+        apos[b, 0] = q[Q_X] + rx
+        apos[b, 1] = q[Q_Y] + ry
+    for b in range(1, n_links):
+        k = q_pin(nw, b)
+        apos[b, 0] = q[k]
+        apos[b, 1] = q[k + 1]
+    return c, s
+
+
+@njit(**INLINE)
+def positions(q, qd, m, w):
+    """Positions (place) and velocities of the pins and wheel centres into w."""
+    c, s = place(q, m, w.apos, w.wc, w.arm)
+    nw = m.arms.shape[0]
+    n_links = w.apos.shape[0] - 1
+    om = qd[Q_PITCH]
+    la = m.par[P_ARM_LENGTH]
+    for i in range(nw):
+        cb = w.arm[i, ARM_COS]
+        sb = w.arm[i, ARM_SIN]
+        rx, ry = wheel_offset(c, s, m.arms, i, la, cb, sb)
+        w.wv[i, 0] = qd[Q_X] - om * ry - qd[Q_ARM + i] * la * sb
+        w.wv[i, 1] = qd[Q_Y] + om * rx + qd[Q_ARM + i] * la * cb
+    for e in range(2):
+        b = 0 if e == 0 else n_links
+        rx, ry = body_offset(c, s, m.ends[e, 0], m.ends[e, 1])
+        w.avel[b, 0] = qd[Q_X] - om * ry
+        w.avel[b, 1] = qd[Q_Y] + om * rx
+    for b in range(1, n_links):
+        k = q_pin(nw, b)
+        w.avel[b, 0] = qd[k]
+        w.avel[b, 1] = qd[k + 1]
+    return c, s
