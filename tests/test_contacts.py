@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from trackbench.model import layout as L
-from trackbench.model.kernels import allocate_neighbours, track_loads
+from trackbench.model.bundles import model_arrays, work_arrays
+from trackbench.model.kernels import track_loads
 from trackbench.model.parameters import pack, paper_track, paper_vehicle
 from trackbench.model.terrain import ground_from_points
 from trackbench.status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
@@ -22,16 +23,17 @@ def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None):
     v["n_wheels"] = len(wheels)
     tr = paper_track()
     tr["n_links"] = len(pins) - 1
-    par, _, _ = pack(v, tr, 9.81)
+    par, piv, ends = pack(v, tr, 9.81)
     g = ground_from_points(ground)
-    nbr, ref = allocate_neighbours(len(wheels), len(g.corners), len(pins) - 1, len(g.segments))
-    avel = np.zeros_like(pins) if velocities is None else np.array(velocities, float)
-    fpin = np.zeros_like(pins)
-    fwheel = np.zeros_like(wheels)
-    lk = np.zeros((len(pins) - 1, 3))
+    m = model_arrays(par, np.column_stack([piv, np.zeros(len(piv))]), ends, g.segments, g.corners, len(pins) - 1)
+    w = work_arrays(len(wheels), len(pins) - 1)
+    w.apos[:] = pins
+    w.wc[:] = wheels
+    if velocities is not None:
+        w.avel[:] = np.array(velocities, float)
     diag = np.zeros(L.n_diag(len(wheels), len(pins) - 1))
-    track_loads(pins, avel, wheels, np.zeros_like(wheels), par, g.segments, g.corners, nbr, ref,
-                lk, fpin, fwheel, diag, L.diag_tension(len(wheels)))
+    track_loads(w, m, diag)
+    fpin, fwheel = w.fpin.copy(), w.fwheel.copy()
     tension = diag[L.diag_tension(len(wheels)):]
     # remove the tension pull so only contact forces remain
     for b, T in enumerate(tension):

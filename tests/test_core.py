@@ -123,19 +123,20 @@ def test_neighbour_lists_equal_full_search(paper_run):
         m = Model(sc, eq, ground)
         m.par[L.P_SKIN] = skin
         res = []
+        off = L.pin_offset(5)
         for i in range(0, ds.sizes["time"], 97):
             y = np.zeros(2 * nq + 1)
             y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch"))
             y[L.Q_ARM:L.Q_ARM + 5] = ds.arm_angle.values[i]
-            y[8:nq:2] = ds.pin_x.values[i, 1:-1]
-            y[9:nq:2] = ds.pin_y.values[i, 1:-1]
+            y[off:nq:2] = ds.pin_x.values[i, 1:-1]
+            y[off + 1:nq:2] = ds.pin_y.values[i, 1:-1]
             dy = np.zeros_like(y)
             d = np.zeros(L.n_diag(5, 30))
-            reduced_rhs(y, m.par, m.arms, m.ends, m.seg, m.corners, m.nbr, m.ref, m.work, dy, d)
+            reduced_rhs(y, m.arrays, m.work, dy, d)
             res.append(np.concatenate([dy, d]))
         out.append(np.array(res))
         if skin < 1:
-            assert int(m.nbr[:-1, 0].max()) < 30  # far pairs were skipped
+            assert int(m.arrays.nbr[:, L.NB_COUNT].max()) < 30  # far pairs were skipped
     np.testing.assert_array_equal(out[0], out[1])
 
 

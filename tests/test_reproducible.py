@@ -19,8 +19,7 @@ if sys.argv[1] == "rhs-first":   # load the right-hand side on its own before th
     eq = equilibrium(sc)
     m = Model(sc, eq, build_ground(sc, eq)[0])
     y0 = initial_state(sc, eq)
-    reduced_rhs(y0, m.par, m.arms, m.ends, m.seg, m.corners, m.nbr, m.ref, m.work, np.zeros_like(y0),
-                np.zeros(L.n_diag(m.nw, m.n_links)))
+    reduced_rhs(y0, m.arrays, m.work, np.zeros_like(y0), np.zeros(L.n_diag(m.nw, m.n_links)))
 ds = tb.simulate(tb.Scenario.paper())
 print(ds.attrs["steps"], hashlib.sha1(ds.chassis_y.values.tobytes()).hexdigest())
 """

@@ -18,7 +18,7 @@ from .gaps import in_pin_wedge, link_coords, link_frames, pin_ground_selection, 
 from .jit import INLINE, KERNEL
 from .layout import (
     C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
-    D_MAX_TENSION, D_MIN_TENSION, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND,
+    D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND,
     K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND,
     P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, diag_tension,
 )
@@ -245,9 +245,10 @@ def wheel_contacts(w, m, diag):
 def _pins_on_ground(w, m, k, hg, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
-    energy, power), carried through in the order of one loop."""
+    energy, power, obstacle force), carried through in the order of one loop. Every
+    segment after the first (the ground the vehicle starts on) belongs to an obstacle."""
     apos, seg = w.apos, m.seg
-    gx, gy, corner_force, energy, power = acc
+    gx, gy, corner_force, energy, power, obstacle = acc
     for b in range(1, apos.shape[0] - 1):
         row = m.nbr_rows[K_PIN_GROUND] + b
         inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, m.nbr, row, hg)
@@ -267,7 +268,9 @@ def _pins_on_ground(w, m, k, hg, acc):
             gy += fy
             energy += 0.5 * k * (hg - s) ** 2
             power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
-    return gx, gy, corner_force, energy, power
+            if sj > 0:
+                obstacle += p
+    return gx, gy, corner_force, energy, power, obstacle
 
 
 @njit(**INLINE)
@@ -277,7 +280,7 @@ def _corner_on_links(c, w, m, k, hg, diag, acc):
     cx = m.corners[c, 0]
     cy = m.corners[c, 1]
     hw = m.par[P_PAD_WHEEL]
-    gx, gy, corner_force, energy, power = acc
+    gx, gy, corner_force, energy, power, obstacle = acc
     row = m.nbr_rows[K_CORNER_LINK] + c
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -298,7 +301,8 @@ def _corner_on_links(c, w, m, k, hg, diag, acc):
         corner_force += p
         energy += 0.5 * k * (hg - s) ** 2
         power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], fx, fy)
-    return gx, gy, corner_force, energy, power
+        obstacle += p
+    return gx, gy, corner_force, energy, power, obstacle
 
 
 @njit(**INLINE)
@@ -307,7 +311,7 @@ def _corner_on_pins(c, w, m, k, hg, acc):
     apos = w.apos
     cx = m.corners[c, 0]
     cy = m.corners[c, 1]
-    gx, gy, corner_force, energy, power = acc
+    gx, gy, corner_force, energy, power, obstacle = acc
     row = m.nbr_rows[K_CORNER_PIN] + c
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -328,7 +332,8 @@ def _corner_on_pins(c, w, m, k, hg, acc):
         corner_force += p
         energy += 0.5 * k * (hg - dist) ** 2
         power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
-    return gx, gy, corner_force, energy, power
+        obstacle += p
+    return gx, gy, corner_force, energy, power, obstacle
 
 
 @njit(**INLINE)
@@ -336,15 +341,16 @@ def ground_contacts(w, m, diag):
     """The track against the ground: pins on segments, then each corner on links and pins."""
     k = m.par[P_K_GROUND]
     hg = m.par[P_PAD_GROUND]
-    acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0))
+    acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     for c in range(m.corners.shape[0]):
         acc = _corner_on_links(c, w, m, k, hg, diag, acc)
         acc = _corner_on_pins(c, w, m, k, hg, acc)
-    gx, gy, corner_force, energy, power = acc
+    gx, gy, corner_force, energy, power, obstacle = acc
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy
     diag[D_CORNER_FORCE] = corner_force
+    diag[D_OBSTACLE_FORCE] = obstacle
     diag[D_POWER] += power
 
 

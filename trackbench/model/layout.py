@@ -158,6 +158,7 @@ D_CHASSIS_AX = 11        # chassis mass-centre acceleration (m/s^2)
 D_CHASSIS_AY = 12
 D_MIN_TENSION = 13
 D_MAX_TENSION = 14
+D_OBSTACLE_FORCE = 15    # ground force on the track from obstacles: corners and every segment after the first (N)
 D_WHEEL = 16             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
@@ -184,7 +185,8 @@ PK_ENERGY_RESIDUAL = 7   # max |work-based residual| (J)
 PK_FIRST_CORNER = 8      # value 1 once a ground corner touched the track; time of first touch
 PK_FIRST_COMPRESSION = 9  # value 1 once any link went into compression; time of first
 PK_SWITCH = 10           # time (column 1) of the last step ended at a located contact switch
-PK_WHEEL_FY = 11         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
+PK_FIRST_OBSTACLE = 11   # value 1 once any part of an obstacle (face, corner, top) touched the track; time
+PK_WHEEL_FY = 12         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
 
 
 def n_peaks(n_wheels):

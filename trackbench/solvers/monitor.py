@@ -7,10 +7,10 @@ from numba import njit
 from ..model.jit import INLINE, KERNEL
 
 from ..model.layout import (
-    D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
+    D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_OBSTACLE_FORCE, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
     D_E_TENSION, D_E_TORSION, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_WHEEL,
     PK_AY_MAX, PK_AY_MIN, PK_ENERGY_BALANCE, PK_ENERGY_RESIDUAL, PK_FIRST_COMPRESSION,
-    PK_FIRST_CORNER, PK_GROUND_FY, PK_SWITCH, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
+    PK_FIRST_CORNER, PK_FIRST_OBSTACLE, PK_GROUND_FY, PK_SWITCH, PK_TENSION_MAX, PK_TENSION_MIN, PK_VX_MIN, PK_WHEEL_FY,
 )
 # The step-size controller grows a step at most 10x (FAC_MAX), so neighbouring steps
 # more unequal than this follow a rejection: a contact switch, a kink or a jump the error
@@ -48,10 +48,19 @@ def init_peaks(peaks):
     peaks[PK_AY_MIN, 0] = np.inf
     peaks[PK_VX_MIN, 0] = np.inf
     peaks[PK_FIRST_CORNER, 0] = 0.0
+    peaks[PK_FIRST_OBSTACLE, 0] = 0.0
     peaks[PK_FIRST_COMPRESSION, 0] = 0.0
     peaks[PK_ENERGY_BALANCE, 0] = 0.0
     peaks[PK_ENERGY_RESIDUAL, 0] = 0.0
     peaks[PK_SWITCH, :] = -1.0
+
+
+@njit(**INLINE)
+def _first(peaks, k, happened, t):
+    """Row k holds 1 and the time of the first accepted step at which it happened."""
+    if peaks[k, 0] == 0.0 and happened:
+        peaks[k, 0] = 1.0
+        peaks[k, 1] = t
 
 
 @njit(**INLINE)
@@ -126,8 +135,7 @@ def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
         peaks[k, 0] *= sign
     _max(peaks, PK_ENERGY_BALANCE, abs(energy_balance(diag) - e_ref), t)
     _max(peaks, PK_ENERGY_RESIDUAL, abs(energy_residual(diag, work) - r_ref), t)
-    if peaks[PK_FIRST_CORNER, 0] == 0.0 and diag[D_CORNER_FORCE] > 0.0:
-        peaks[PK_FIRST_CORNER, 0] = 1.0
-        peaks[PK_FIRST_CORNER, 1] = t
+    _first(peaks, PK_FIRST_CORNER, diag[D_CORNER_FORCE] > 0.0, t)
+    _first(peaks, PK_FIRST_OBSTACLE, diag[D_OBSTACLE_FORCE] > 0.0, t)
     if at_switch:
         peaks[PK_SWITCH, 1] = t
