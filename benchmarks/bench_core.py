@@ -36,9 +36,9 @@ def fresh_process_seconds(cache_dir):
 
 
 @njit(cache=True)
-def _rhs_loop(n, y, par, arms, ends, seg, corners, nbr, ref, work, dy, d):
+def _rhs_loop(n, y, m, w, dy, d):
     for _ in range(n):
-        reduced_rhs(y, par, arms, ends, seg, corners, nbr, ref, work, dy, d)
+        reduced_rhs(y, m, w, dy, d)
 
 
 def rhs_microseconds(ds, sc):
@@ -49,8 +49,8 @@ def rhs_microseconds(ds, sc):
     nq = L.n_coordinates(m.nw, m.n_links)
     i = int(np.searchsorted(ds.time.values, 0.3))
     y = np.zeros(2 * nq + 1)
-    y[:3] = [float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")]
-    y[3:3 + m.nw] = ds.arm_angle.values[i]
+    y[[L.Q_X, L.Q_Y, L.Q_PITCH]] = [float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")]
+    y[L.Q_ARM:L.Q_ARM + m.nw] = ds.arm_angle.values[i]
     off = L.pin_offset(m.nw)
     y[off:nq:2] = ds.pin_x.values[i, 1:-1]
     y[off + 1:nq:2] = ds.pin_y.values[i, 1:-1]
@@ -58,7 +58,7 @@ def rhs_microseconds(ds, sc):
     y[nq + off:2 * nq:2] = 10.0
     dy = np.zeros_like(y)
     d = np.zeros(L.n_diag(m.nw, m.n_links))
-    args = (m.par, m.arms, m.ends, m.seg, m.corners, m.nbr, m.ref, m.work, dy, d)
+    args = (m.arrays, m.work, dy, d)
     _rhs_loop(10, y, *args)
     n = 200_000
     best = np.inf
@@ -77,7 +77,7 @@ def scipy_baseline(sc, method):
     m = Model(sc, eq, ground)
     y0 = initial_state(sc, eq)
     d = np.zeros(L.n_diag(m.nw, m.n_links))
-    args = (m.par, m.arms, m.ends, m.seg, m.corners, m.nbr, m.ref, m.work)
+    args = (m.arrays, m.work)
 
     def f(t, y):
         dy = np.empty_like(y)

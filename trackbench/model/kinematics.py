@@ -26,16 +26,6 @@ def wheel_offset(c, s, arms, i, la, cb, sb):
 
 
 @njit(**INLINE)
-def end_pin(b, n_links):
-    """Which track end pin b is (0 front, 1 rear), or -1 for a free pin."""
-    if b == 0:
-        return 0
-    if b == n_links:
-        return 1
-    return -1
-
-
-@njit(**INLINE)
 def place(q, m, apos, wc, arm):
     """Pin and wheel-centre positions of configuration q into apos and wc; cos and sin of
     each arm's absolute angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""

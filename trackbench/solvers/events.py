@@ -15,10 +15,9 @@ model/kinematics.py.
 
 import math
 
-import numpy as np
 from numba import njit
 
-from ..model.gaps import (link_frame, link_frames, pin_ground_selection, pin_segment_valid, point_on_link,
+from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, point_on_link,
                           segment_coords, wedge)
 from ..model.jit import INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
