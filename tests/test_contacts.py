@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from trackbench.model import layout as L
-from trackbench.model.bundles import model_arrays, work_arrays
+from trackbench.model.bundles import arm_table, model_arrays, work_arrays
 from trackbench.model.kernels import track_loads
 from trackbench.model.parameters import pack, paper_track, paper_vehicle
 from trackbench.model.terrain import ground_from_points
@@ -25,8 +25,8 @@ def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None):
     tr["n_links"] = len(pins) - 1
     par, piv, ends = pack(v, tr, 9.81)
     g = ground_from_points(ground)
-    m = model_arrays(par, np.column_stack([piv, np.zeros(len(piv))]), ends, g.segments, g.corners, len(pins) - 1)
-    w = work_arrays(len(wheels), len(pins) - 1)
+    m = model_arrays(par, arm_table(piv, 0.0, 0.0), ends, g.segments, g.corners, len(pins) - 1)
+    w = work_arrays(m, len(wheels), len(pins) - 1)
     w.apos[:] = pins
     w.wc[:] = wheels
     if velocities is not None:

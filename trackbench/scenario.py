@@ -13,9 +13,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model.parameters import GRAVITY, paper_track, paper_vehicle, wheel_centres_body
+from .model.contact_laws import DAMPINGS, LAWS
+
+from .model.parameters import GRAVITY, paper_contact, paper_track, paper_vehicle, wheel_centres_body
+from .presets import PRESETS, preset_values
 
 SOLVERS = ("reduced", "lee")
+GEOMETRIES = ("paper",)
 METHODS = ("dop853", "dopri5")
 TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
 OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
@@ -29,6 +33,7 @@ def paper_step():
     """The paper's run: 10 m/s over a 0.1 m step first touched at t = 0.0568 s."""
     return {
         "name": "paper_step",
+        "preset": "paper",
         "speed": 10.0,
         "duration": 0.5,
         "gravity": GRAVITY,
@@ -41,6 +46,7 @@ def paper_step():
         "seed": 0,
         "vehicle": paper_vehicle(),
         "track": paper_track(),
+        "contact": paper_contact(),
         "terrain": {"kind": "step", "height": 0.1, "first_contact_time": 0.0568},
         "lee": {"accel_order": 10, "eps_iterations": 10, "position_tol": 1e-9,
                 "max_iterations": 500, "matrix_update_angle": 1e-3},
@@ -50,8 +56,10 @@ def paper_step():
 
 # name -> (type, low, high, what is allowed). Bounds are exclusive where marked by the text.
 _POS = (float, 0.0, math.inf, "a number > 0")
+_NONNEG = (float, 0.0, math.inf, "a number >= 0")
 RULES = {
     "name": (str, None, None, "a text"),
+    "preset": (str, tuple(PRESETS), None, "one of " + ", ".join(PRESETS)),
     "speed": (float, 0.0, 100.0, "a number in [0, 100] m/s"),
     "duration": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
     "gravity": (float, 0.0, 100.0, "a number in [0, 100] m/s^2"),
@@ -84,6 +92,16 @@ RULES = {
     "track.pad_ground": _POS,
     "track.wheel_stiffness": _POS,
     "track.ground_stiffness": _POS,
+    "track.link_damping": (float, 0.0, math.inf, "a number >= 0 (N s/m)"),
+    "vehicle.arm_damping": (list, None, None, "a list of one number >= 0 (N m s/rad) per road wheel, or []"),
+    "contact.law": (str, tuple(LAWS), None, "one of " + ", ".join(LAWS)),
+    "contact.exponent": (float, 0.0, 3.0, "a number in (0, 3]"),
+    "contact.damping": (str, tuple(DAMPINGS), None, "one of " + ", ".join(DAMPINGS)),
+    "contact.damping_ratio": (float, 0.0, 10.0, "a number in [0, 10]"),
+    "contact.restitution": (float, 0.0, 1.0, "a number in (0, 1]"),
+    "contact.damping_ramp": (float, 0.0, 0.1, "a number in (0, 0.1] m"),
+    "contact.min_approach_speed": (float, 0.0, 100.0, "a number in (0, 100] m/s"),
+    "contact.geometry": (str, GEOMETRIES, None, "one of " + ", ".join(GEOMETRIES)),
     "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
@@ -92,7 +110,8 @@ RULES = {
     "record.enabled": (bool, None, None, "true or false"),
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }
-_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle"} | {
+_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent",
+             "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed"} | {
     k for k, r in RULES.items() if r is _POS}
 
 TERRAIN_RULES = {
@@ -300,20 +319,49 @@ def _check_geometry(v, tr):
         raise ScenarioError("track.link_length must exceed 2 * track.pad_ground")
 
 
+def _dotted_keys(d, prefix=""):
+    """The dotted parameter names set in a (possibly nested) overrides dict."""
+    out = set()
+    for k, v in d.items():
+        name = prefix + k
+        if isinstance(v, dict) and name != "terrain" and not name.startswith("terrain."):
+            out |= _dotted_keys(v, name + ".")
+        else:
+            out.add(name)
+    return out
+
+
+def _apply_preset(d, explicit):
+    """Every parameter a preset may set takes the scenario's preset value (or the paper's
+    where this preset leaves it), unless it was given explicitly."""
+    paper = flatten(paper_step())
+    values = preset_values(d["preset"], d)
+    controlled = set()
+    for name in PRESETS:
+        controlled |= set(preset_values(name, d))
+    for name in controlled - set(explicit):
+        set_dotted(d, name, copy.deepcopy(values.get(name, paper[name])))
+
+
 @dataclass(frozen=True)
 class Scenario:
-    """A validated, fully resolved scenario. Build with from_dict or paper()."""
+    """A validated, fully resolved scenario. Build with from_dict or paper().
+    explicit: the dotted names set by the user rather than by defaults or a preset."""
     data: dict
+    explicit: frozenset = frozenset()
 
     @classmethod
     def paper(cls, **overrides):
         return cls.from_dict(overrides)
 
     @classmethod
-    def from_dict(cls, overrides=None, base=None):
+    def from_dict(cls, overrides=None, base=None, explicit=None):
         """Defaults (the paper's run, or ``base``) updated by ``overrides``; keys may be
-        nested tables or dotted names."""
+        nested tables or dotted names. A base given as a plain dict counts as explicit
+        throughout (it is a resolved scenario: its preset values stay as they are)."""
         d = copy.deepcopy(base if base is not None else paper_step())
+        if explicit is None:
+            explicit = frozenset(flatten(d)) if base is not None else frozenset()
         nested = {}
         for k, v in (overrides or {}).items():
             if not isinstance(k, str):
@@ -323,10 +371,13 @@ class Scenario:
                     raise _unknown(k, parameter_names())
             set_dotted(nested, k, v)
         _merge(d, nested)
-        return cls(validate(d))
+        explicit = frozenset(explicit | _dotted_keys(nested))
+        d["preset"] = _check_value("preset", d.get("preset"), RULES["preset"])
+        _apply_preset(d, explicit)
+        return cls(validate(d, explicit), explicit)
 
     def with_overrides(self, overrides):
-        return Scenario.from_dict(overrides, base=self.data)
+        return Scenario.from_dict(overrides, base=self.data, explicit=self.explicit)
 
     def to_dict(self):
         return copy.deepcopy(self.data)
@@ -342,7 +393,36 @@ class Scenario:
         return self.data["name"]
 
 
-def validate(d):
+def _check_extensions(d, explicit):
+    """The models beyond the paper: coefficients that belong together, sizes that must
+    match, and what the lee solver supports."""
+    c = d["contact"]
+    if c["damping"] == "viscous" and c["damping_ratio"] <= 0.0:
+        raise ScenarioError("contact.damping = 'viscous' needs contact.damping_ratio > 0 (e.g. 0.1); "
+                            "or contact.damping = 'none'")
+    if c["damping"] in ("hunt_crossley", "lankarani_nikravesh", "flores") and \
+            "contact.restitution" not in explicit:
+        raise ScenarioError(f"contact.damping = '{c['damping']}' needs contact.restitution, a number in (0, 1] "
+                            "(e.g. 0.75)")
+    arms = d["vehicle"]["arm_damping"]
+    n = d["vehicle"]["n_wheels"]
+    if arms and len(arms) != n:
+        raise ScenarioError(f"vehicle.arm_damping has {len(arms)} values for {n} road wheels: give one per wheel "
+                            "(0 = no shock absorber), or [] for none")
+    for i, a in enumerate(arms):
+        if isinstance(a, bool) or not isinstance(a, (int, float)) or not (math.isfinite(a) and a >= 0.0):
+            raise ScenarioError(f"vehicle.arm_damping[{i}] = {a!r} is not allowed: expected a number >= 0 (N m s/rad)")
+    if d["solver"] == "lee":
+        ext = [name for name, on in (
+            ("contact.law", c["law"] != "linear"), ("contact.damping", c["damping"] != "none"),
+            ("contact.geometry", c["geometry"] != "paper"), ("track.link_damping", d["track"]["link_damping"] > 0),
+            ("vehicle.arm_damping", any(a > 0 for a in arms))) if on]
+        if ext:
+            raise ScenarioError(f"solver = 'lee' runs the paper's model only, but {ext[0]} is set; "
+                                "use solver = 'reduced' for the models beyond the paper")
+
+
+def validate(d, explicit=frozenset()):
     out = copy.deepcopy(d)
     flat = flatten({k: v for k, v in d.items() if k != "terrain"})
     for name, value in flat.items():
@@ -356,4 +436,6 @@ def validate(d):
     if out["duration"] / out["output_interval"] > 2_000_000:
         raise ScenarioError("output_interval is too small for this duration: at most 2,000,000 output samples")
     _check_geometry(out["vehicle"], out["track"])
+    out["vehicle"]["arm_damping"] = [float(a) for a in out["vehicle"]["arm_damping"]]
+    _check_extensions(out, explicit)
     return out

@@ -11,8 +11,8 @@ import numpy as np
 
 from .model import layout as L
 from .model.equilibrium import solve_equilibrium
-from .model.bundles import model_arrays, work_arrays
-from .model.parameters import pack, total_mass
+from .model.bundles import arm_table, model_arrays, work_arrays
+from .model.parameters import arm_damping, pack, total_mass
 from .model.terrain import FAR, ground_from_points, obstacle_points
 from .output import build_dataset
 from .scenario import Scenario
@@ -20,13 +20,14 @@ from .scenario import Scenario
 
 @functools.lru_cache(maxsize=32)
 def _equilibrium_cached(key):
-    vehicle, track, gravity = json.loads(key)
-    return solve_equilibrium(vehicle, track, gravity)
+    vehicle, track, gravity, contact = json.loads(key)
+    return solve_equilibrium(vehicle, track, gravity, contact)
 
 
 def equilibrium(scenario: Scenario):
     """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
-    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"]], sort_keys=True)
+    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"]],
+                     sort_keys=True)
     return _equilibrium_cached(key)
 
 
@@ -92,7 +93,7 @@ def build_ground(scenario: Scenario, eq):
 def initial_state(scenario: Scenario, eq):
     """y0 = (q, qd, W): the equilibrium moving at `speed`, pins nudged if asked."""
     nq = eq.q.size
-    y0 = np.zeros(2 * nq + 1)
+    y0 = np.zeros(L.n_state(nq))
     y0[:nq] = eq.q
     nw = scenario["vehicle.n_wheels"]
     off = L.pin_offset(nw)
@@ -110,12 +111,12 @@ class Model:
 
     def __init__(self, scenario: Scenario, eq, ground):
         v, tr = scenario["vehicle"], scenario["track"]
-        par, piv, ends = pack(v, tr, scenario["gravity"])
+        par, piv, ends = pack(v, tr, scenario["gravity"], scenario["contact"])
         self.nw = int(v["n_wheels"])
         self.n_links = int(tr["n_links"])
-        arms = np.column_stack([piv, eq.phi0])
+        arms = arm_table(piv, eq.phi0, arm_damping(v))
         self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links)
-        self.work = work_arrays(self.nw, self.n_links)
+        self.work = work_arrays(self.arrays, self.nw, self.n_links)
         self.weight = total_mass(v, tr) * scenario["gravity"]
 
     @property

@@ -13,7 +13,7 @@ from . import layout as L
 # refreshes as the track moves, and the counters.
 ModelArrays = namedtuple("ModelArrays", [
     "par",        # (N_PAR,) scalar parameters, P_*
-    "arms",       # (n_wheels, 3) arm pivot body point (x, y) and torsion-bar free angle phi0
+    "arms",       # (n_wheels, N_ARMS_COLS) pivot body point, torsion-bar free angle, damper (ARMS_*)
     "ends",       # (2, 2) track-end body points: front (pin 0), rear (pin n_links)
     "seg",        # (n_segments, N_SEG_COLS) ground segments, SEG_*
     "corners",    # (n_corners, 2) convex ground corners
@@ -21,6 +21,8 @@ ModelArrays = namedtuple("ModelArrays", [
     "nbr_rows",   # int (N_KINDS + 1,) first row of each pair kind's block in nbr, K_*
     "ref",        # (n_pins + n_wheels, 2) pin and wheel positions when nbr was built
     "counters",   # int (N_COUNTERS,) C_*
+    "v0",         # (rows, width - 1) approach speed of each pair at its onset, nbr's row layout
+                  # and the partner (link, pin or segment) as column; 0 = not in contact
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -34,10 +36,22 @@ Work = namedtuple("Work", [
     "fwheel",     # (n_wheels, 2) out: contact force of the track on each wheel
     "lk",         # (n_links, 3) per link: unit direction t (pin b -> b+1) and length
     "arm",        # (n_wheels, ARM_COLS) per arm: cos and sin of beta, the chassis coupling
+    "pair_seen",  # int (rows, width - 1): the evaluation (C_EVALUATIONS) that last found the pair
+                  # in contact, for the laws that remember an approach speed
+    "pair_rate",  # (rows, width - 1): its compression rate then
 ])
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
 ARM_COLS = 6
+
+
+def arm_table(pivots, phi0, damping):
+    """The arms array: pivot body points, torsion-bar free angles, rotary dampers."""
+    arms = np.zeros((len(pivots), L.N_ARMS_COLS))
+    arms[:, [L.ARMS_PX, L.ARMS_PY]] = pivots
+    arms[:, L.ARMS_PHI0] = phi0
+    arms[:, L.ARMS_DAMPING] = damping
+    return arms
 
 
 def model_arrays(par, arms, ends, seg, corners, n_links):
@@ -49,14 +63,16 @@ def model_arrays(par, arms, ends, seg, corners, n_links):
     return ModelArrays(np.ascontiguousarray(par, dtype=float), np.ascontiguousarray(arms, dtype=float),
                        np.ascontiguousarray(ends, dtype=float), np.ascontiguousarray(seg, dtype=float),
                        np.ascontiguousarray(corners, dtype=float).reshape(-1, 2), nbr,
-                       np.array(rows, dtype=np.int64), ref, np.zeros(L.N_COUNTERS, dtype=np.int64))
+                       np.array(rows, dtype=np.int64), ref, np.zeros(L.N_COUNTERS, dtype=np.int64),
+                       np.zeros((nbr.shape[0], nbr.shape[1] - 1)))
 
 
-def work_arrays(n_wheels, n_links):
+def work_arrays(m, n_wheels, n_links):
     n_pins = n_links + 1
     return Work(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
                 np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
-                np.zeros((n_links, 3)), np.zeros((n_wheels, ARM_COLS)))
+                np.zeros((n_links, 3)), np.zeros((n_wheels, ARM_COLS)),
+                np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape))
 
 
 # Scratch of the event location (solvers/events.py): the configuration at both ends of

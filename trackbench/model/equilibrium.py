@@ -14,7 +14,7 @@ from numba import njit
 
 from . import layout as L
 from .jit import KERNEL
-from .bundles import model_arrays, work_arrays
+from .bundles import arm_table, model_arrays, work_arrays
 from .parameters import equilibrium_arm_angle, pack, total_mass
 from .reduced import reduced_rhs
 from .terrain import flat_ground
@@ -96,15 +96,15 @@ def initial_track(ends_world, wheel_centres, rho, n_links):
 class _Problem:
     """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins)."""
 
-    def __init__(self, vehicle, track, gravity):
-        self.par, piv, self.ends = pack(vehicle, track, gravity)
+    def __init__(self, vehicle, track, gravity, contact=None):
+        self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
         self.nw = int(vehicle["n_wheels"])
         self.n_links = int(track["n_links"])
         self.phi = equilibrium_arm_angle(vehicle)
-        self.arms = np.column_stack([piv, np.full(self.nw, self.phi)])
+        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
         g = flat_ground()
         self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links)
-        self.work = work_arrays(self.nw, self.n_links)
+        self.work = work_arrays(self.m, self.nw, self.n_links)
         self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
         self.nq = L.n_coordinates(self.nw, self.n_links)
         self.weight = total_mass(vehicle, track) * gravity
@@ -155,10 +155,10 @@ def _loads_at_rest(q, m, w, diag):
     """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
-    y = np.zeros(2 * nq + 1)
+    y = np.zeros(L.n_state(nq))
     for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
         y[k] = q[k]
-    ydot = np.empty(2 * nq + 1)
+    ydot = np.empty(L.n_state(nq))
     reduced_rhs(y, m, w, ydot, diag)
 
 
@@ -205,13 +205,13 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     return fx
 
 
-def solve_equilibrium(vehicle, track, gravity, tol_rel=1e-12, max_iter=60):
+def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_iter=60):
     """Newton iteration with a finite-difference Jacobian and a backtracking line search."""
-    P = _Problem(vehicle, track, gravity)
+    P = _Problem(vehicle, track, gravity, contact)
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
     hg = P.par[L.P_PAD_GROUND]
     # start: wheels resting on the track, the track on the ground, chassis level
-    wcb = P.arms[:, :2] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
+    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
     yc = -wcb[:, 1].min() + rho + hg
     ends_w = P.ends + [0.0, yc]
     pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)

@@ -15,9 +15,12 @@ from numba import njit
 
 from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 from .gaps import in_pin_wedge, link_coords, link_frames, pin_ground_selection, pin_segment_acts, segment_coords
+from .contact_force import normal_force
+from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE
 from .jit import INLINE, KERNEL
 from .layout import (
-    C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
+    C_EVALUATIONS, C_REBUILDS, D_CORNER_FORCE, D_DISSIPATION, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT,
+    P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
     D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND,
     K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND,
     P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, diag_tension,
@@ -125,15 +128,18 @@ def refresh_neighbours(w, m):
 
 @njit(**INLINE)
 def link_tensions(w, par, diag):
-    """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; sets fpin to the pull
-    on every pin, stores t and length in lk and T in diag."""
+    """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways, plus the link's axial
+    dashpot c l' where track.link_damping is set; sets fpin to the pull on every pin,
+    stores t and length in lk and T in diag."""
     apos, lk, fpin = w.apos, w.lk, w.fpin
     k = par[P_LINK_STIFFNESS]
     l0 = par[P_LINK_LENGTH]
+    c = par[P_LINK_DAMPING]
     t_off = diag_tension(w.wc.shape[0])
     fpin[0, 0] = 0.0
     fpin[0, 1] = 0.0
     energy = 0.0
+    power = 0.0
     tmin = np.inf
     tmax = -np.inf
     link_frames(apos, lk)
@@ -142,6 +148,10 @@ def link_tensions(w, par, diag):
         ty = lk[b, 1]
         stretch = lk[b, 2] - l0
         tension = k * stretch
+        if c != 0.0:
+            rate = (w.avel[b + 1, 0] - w.avel[b, 0]) * tx + (w.avel[b + 1, 1] - w.avel[b, 1]) * ty
+            tension += c * rate
+            power += c * rate * rate
         diag[t_off + b] = tension
         energy += 0.5 * k * stretch * stretch
         tmin = min(tmin, tension)
@@ -153,6 +163,8 @@ def link_tensions(w, par, diag):
     diag[D_E_TENSION] = energy
     diag[D_MIN_TENSION] = tmin
     diag[D_MAX_TENSION] = tmax
+    diag[D_DISSIPATION] += power
+    diag[D_POWER] -= power
 
 
 @njit(**KERNEL)
@@ -169,11 +181,43 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
 
 
 @njit(**INLINE)
-def _wheel_on_links(i, w, m, k, rho, diag, acc):
-    """Road wheel i against the links (Fig. 3, Eq. 4). acc = (fx, fy, energy, power) is
-    carried through, not summed apart and added: every sum keeps the order of one loop."""
+def _link_rate(vx, vy, w, b, d0):
+    """ds/dt of a point moving at v against link b (s along the inner normal, d0 its foot):
+    (v - a_b') . n_b + d0 omega_b, omega_b the link's rotation rate."""
+    lk, avel = w.lk, w.avel
+    dvx = avel[b + 1, 0] - avel[b, 0]
+    dvy = avel[b + 1, 1] - avel[b, 1]
+    omega = (lk[b, 0] * dvy - lk[b, 1] * dvx) / lk[b, 2]
+    return (vx - avel[b, 0]) * lk[b, 1] - (vy - avel[b, 1]) * lk[b, 0] + d0 * omega
+
+
+@njit(**INLINE)
+def _force(m, w, kc, row, j, delta, delta_dot):
+    """(force, pad energy, dissipated power) of candidate j of row at compression delta
+    by the scenario's contact law; kc: P_C_WHEEL or P_C_GROUND. The approach speed v0 is
+    the one remembered at the pair's onset (remember_onsets), or, for an onset inside the
+    current step, the current rate (it becomes the memory once the step is accepted)."""
+    par = m.par
+    partner = m.nbr[row, 1 + j]
+    v0 = m.v0[row, partner]
+    if par[P_CONTACT_DAMPING] >= DAMPING_HUNT_CROSSLEY:
+        w.pair_seen[row, partner] = m.counters[C_EVALUATIONS]
+        w.pair_rate[row, partner] = delta_dot
+        if v0 <= 0.0:
+            v0 = max(delta_dot, par[P_MIN_APPROACH])
+    k = par[P_K_WHEEL] if kc == P_C_WHEEL else par[P_K_GROUND]
+    return normal_force(int(par[P_CONTACT_LAW]), int(par[P_CONTACT_DAMPING]), k, par[P_CONTACT_EXPONENT], par[kc],
+                        par[P_RESTITUTION_FACTOR], par[P_DAMPING_RAMP], delta, delta_dot, v0)
+
+
+@njit(**INLINE)
+def _wheel_on_links(i, w, m, rho, diag, acc):
+    """Road wheel i against the links (Fig. 3, Eq. 4). acc = (fx, fy, energy, power,
+    dissipation) is carried through, not summed apart and added: every sum keeps the order
+    of one loop."""
     apos, lk, wc = w.apos, w.lk, w.wc
-    fwx, fwy, energy, power = acc
+    damped = m.par[P_CONTACT_DAMPING] != DAMPING_NONE
+    fwx, fwy, energy, power, dissipation = acc
     row = m.nbr_rows[K_WHEEL_LINK] + i
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -185,22 +229,25 @@ def _wheel_on_links(i, w, m, k, rho, diag, acc):
         if s < 0.0:
             diag[D_STATUS] = WHEEL_THROUGH_TRACK
             continue
-        p = k * (rho - s)  # Eq. (4)
+        rate = -_link_rate(w.wv[i, 0], w.wv[i, 1], w, b, d0) if damped else 0.0
+        p, e, pd = _force(m, w, P_C_WHEEL, row, j, rho - s, rate)  # Eq. (4)
         fx = p * lk[b, 1]
         fy = -p * lk[b, 0]
         fwx += fx
         fwy += fy
-        energy += 0.5 * k * (rho - s) ** 2
+        energy += e
+        dissipation += pd
         power += fx * w.wv[i, 0] + fy * w.wv[i, 1]
         power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], -fx, -fy)
-    return fwx, fwy, energy, power
+    return fwx, fwy, energy, power, dissipation
 
 
 @njit(**INLINE)
-def _wheel_on_pins(i, w, m, k, rho, acc):
+def _wheel_on_pins(i, w, m, rho, acc):
     """Road wheel i against free pins in the wedge (Fig. 4); acc as in _wheel_on_links."""
     apos, avel, wc = w.apos, w.avel, w.wc
-    fwx, fwy, energy, power = acc
+    damped = m.par[P_CONTACT_DAMPING] != DAMPING_NONE
+    fwx, fwy, energy, power, dissipation = acc
     row = m.nbr_rows[K_WHEEL_PIN] + i
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -211,44 +258,48 @@ def _wheel_on_pins(i, w, m, k, rho, acc):
         dist = math.sqrt(dx * dx + dy * dy)
         if dist >= rho:
             continue
-        p = k * (rho - dist)
+        rate = -(dx * (w.wv[i, 0] - avel[b, 0]) + dy * (w.wv[i, 1] - avel[b, 1])) / dist if damped else 0.0
+        p, e, pd = _force(m, w, P_C_WHEEL, row, j, rho - dist, rate)
         fx = p * dx / dist
         fy = p * dy / dist
         fwx += fx
         fwy += fy
         w.fpin[b, 0] -= fx
         w.fpin[b, 1] -= fy
-        energy += 0.5 * k * (rho - dist) ** 2
+        energy += e
+        dissipation += pd
         power += fx * (w.wv[i, 0] - avel[b, 0]) + fy * (w.wv[i, 1] - avel[b, 1])
-    return fwx, fwy, energy, power
+    return fwx, fwy, energy, power, dissipation
 
 
 @njit(**INLINE)
 def wheel_contacts(w, m, diag):
     """Every road wheel against the track: links, then pins in the wedge."""
-    k = m.par[P_K_WHEEL]
     rho = m.par[P_WHEEL_RADIUS] + m.par[P_PAD_WHEEL]
     energy = 0.0
     power = 0.0
+    dissipation = 0.0
     for i in range(w.wc.shape[0]):
-        acc = _wheel_on_links(i, w, m, k, rho, diag, (0.0, 0.0, energy, power))
-        fwx, fwy, energy, power = _wheel_on_pins(i, w, m, k, rho, acc)
+        acc = _wheel_on_links(i, w, m, rho, diag, (0.0, 0.0, energy, power, dissipation))
+        fwx, fwy, energy, power, dissipation = _wheel_on_pins(i, w, m, rho, acc)
         w.fwheel[i, 0] = fwx
         w.fwheel[i, 1] = fwy
         diag[D_WHEEL + 2 * i] = fwx
         diag[D_WHEEL + 2 * i + 1] = fwy
     diag[D_E_PAD_WHEEL] = energy
     diag[D_POWER] += power
+    diag[D_DISSIPATION] += dissipation
 
 
 @njit(**INLINE)
-def _pins_on_ground(w, m, k, hg, acc):
+def _pins_on_ground(w, m, hg, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
-    energy, power, obstacle force), carried through in the order of one loop. Every
-    segment after the first (the ground the vehicle starts on) belongs to an obstacle."""
+    energy, power, obstacle force, dissipation), carried through in the order of one loop.
+    Every segment after the first (the ground the vehicle starts on) is an obstacle's."""
     apos, seg = w.apos, m.seg
-    gx, gy, corner_force, energy, power, obstacle = acc
+    damped = m.par[P_CONTACT_DAMPING] != DAMPING_NONE
+    gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, apos.shape[0] - 1):
         row = m.nbr_rows[K_PIN_GROUND] + b
         inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, m.nbr, row, hg)
@@ -259,28 +310,31 @@ def _pins_on_ground(w, m, k, hg, acc):
             lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, sj)
             if not pin_segment_acts(lam, s, seg, sj, hg, inside, n_below, best):
                 continue
-            p = k * (hg - s)  # Eq. (6)
+            rate = -(w.avel[b, 0] * seg[sj, SEG_NX] + w.avel[b, 1] * seg[sj, SEG_NY]) if damped else 0.0
+            p, e, pd = _force(m, w, P_C_GROUND, row, j, hg - s, rate)  # Eq. (6)
             fx = p * seg[sj, SEG_NX]
             fy = p * seg[sj, SEG_NY]
             w.fpin[b, 0] += fx
             w.fpin[b, 1] += fy
             gx += fx
             gy += fy
-            energy += 0.5 * k * (hg - s) ** 2
+            energy += e
+            dissipation += pd
             power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
             if sj > 0:
                 obstacle += p
-    return gx, gy, corner_force, energy, power, obstacle
+    return gx, gy, corner_force, energy, power, obstacle, dissipation
 
 
 @njit(**INLINE)
-def _corner_on_links(c, w, m, k, hg, diag, acc):
+def _corner_on_links(c, w, m, hg, diag, acc):
     """Ground corner c against the links (Fig. 5 right), split by Eq. (7); acc as above."""
     apos, lk = w.apos, w.lk
     cx = m.corners[c, 0]
     cy = m.corners[c, 1]
     hw = m.par[P_PAD_WHEEL]
-    gx, gy, corner_force, energy, power, obstacle = acc
+    damped = m.par[P_CONTACT_DAMPING] != DAMPING_NONE
+    gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     row = m.nbr_rows[K_CORNER_LINK] + c
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -293,25 +347,28 @@ def _corner_on_links(c, w, m, k, hg, diag, acc):
         if s < 0.0:
             diag[D_STATUS] = CORNER_THROUGH_TRACK
             continue
-        p = k * (hg - s)
+        rate = _link_rate(0.0, 0.0, w, b, d0) if damped else 0.0   # d(s_in)/dt = -ds/dt
+        p, e, pd = _force(m, w, P_C_GROUND, row, j, hg - s, rate)
         fx = p * lk[b, 1]
         fy = -p * lk[b, 0]
         gx += fx
         gy += fy
         corner_force += p
-        energy += 0.5 * k * (hg - s) ** 2
+        energy += e
+        dissipation += pd
         power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], fx, fy)
         obstacle += p
-    return gx, gy, corner_force, energy, power, obstacle
+    return gx, gy, corner_force, energy, power, obstacle, dissipation
 
 
 @njit(**INLINE)
-def _corner_on_pins(c, w, m, k, hg, acc):
+def _corner_on_pins(c, w, m, hg, acc):
     """Ground corner c against free pins in the wedge (Fig. 6); acc as above."""
     apos = w.apos
     cx = m.corners[c, 0]
     cy = m.corners[c, 1]
-    gx, gy, corner_force, energy, power, obstacle = acc
+    damped = m.par[P_CONTACT_DAMPING] != DAMPING_NONE
+    gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     row = m.nbr_rows[K_CORNER_PIN] + c
     for j in range(m.nbr[row, NB_COUNT]):
         b = m.nbr[row, 1 + j]
@@ -322,7 +379,8 @@ def _corner_on_pins(c, w, m, k, hg, acc):
         dist = math.sqrt(dx * dx + dy * dy)
         if dist >= hg:
             continue
-        p = k * (hg - dist)
+        rate = (dx * w.avel[b, 0] + dy * w.avel[b, 1]) / dist if damped else 0.0
+        p, e, pd = _force(m, w, P_C_GROUND, row, j, hg - dist, rate)
         fx = -p * dx / dist
         fy = -p * dy / dist
         w.fpin[b, 0] += fx
@@ -330,28 +388,29 @@ def _corner_on_pins(c, w, m, k, hg, acc):
         gx += fx
         gy += fy
         corner_force += p
-        energy += 0.5 * k * (hg - dist) ** 2
+        energy += e
+        dissipation += pd
         power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
         obstacle += p
-    return gx, gy, corner_force, energy, power, obstacle
+    return gx, gy, corner_force, energy, power, obstacle, dissipation
 
 
 @njit(**INLINE)
 def ground_contacts(w, m, diag):
     """The track against the ground: pins on segments, then each corner on links and pins."""
-    k = m.par[P_K_GROUND]
     hg = m.par[P_PAD_GROUND]
-    acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    acc = _pins_on_ground(w, m, hg, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     for c in range(m.corners.shape[0]):
-        acc = _corner_on_links(c, w, m, k, hg, diag, acc)
-        acc = _corner_on_pins(c, w, m, k, hg, acc)
-    gx, gy, corner_force, energy, power, obstacle = acc
+        acc = _corner_on_links(c, w, m, hg, diag, acc)
+        acc = _corner_on_pins(c, w, m, hg, acc)
+    gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy
     diag[D_CORNER_FORCE] = corner_force
     diag[D_OBSTACLE_FORCE] = obstacle
     diag[D_POWER] += power
+    diag[D_DISSIPATION] += dissipation
 
 
 @njit(**INLINE)
@@ -362,7 +421,28 @@ def track_loads(w, m, diag):
     status in diag. Gravity is left to the caller."""
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
+    diag[D_DISSIPATION] = 0.0
+    m.counters[C_EVALUATIONS] += 1
     refresh_neighbours(w, m)
     link_tensions(w, m.par, diag)
     wheel_contacts(w, m, diag)
     ground_contacts(w, m, diag)
+
+
+@njit(**KERNEL)
+def remember_onsets(m, w):
+    """After an accepted step (the last evaluation was at its end state): pairs in contact
+    there keep the approach speed of their onset, a pair that came into contact in the
+    step takes its compression rate now (the event location ends such a step just after
+    the onset), a pair out of contact forgets it. Only the laws by restitution use it;
+    memory is never touched inside a step, so a rejected step leaves no trace."""
+    if m.par[P_CONTACT_DAMPING] < DAMPING_HUNT_CROSSLEY:
+        return
+    now = m.counters[C_EVALUATIONS]
+    v_min = m.par[P_MIN_APPROACH]
+    for row in range(m.v0.shape[0]):
+        for p in range(m.v0.shape[1]):
+            if w.pair_seen[row, p] != now:
+                m.v0[row, p] = 0.0
+            elif m.v0[row, p] <= 0.0:
+                m.v0[row, p] = max(w.pair_rate[row, p], v_min)

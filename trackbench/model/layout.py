@@ -1,11 +1,12 @@
 """Index tables: the one place that says where each quantity lives in the arrays
 the compiled kernels share.
 
-Reduced-coordinate state ``y`` (length ``2 * nq + 1``)::
+Reduced-coordinate state ``y`` (length ``2 * nq + 2``)::
 
     q   = y[0:nq]          generalised coordinates
     qd  = y[nq:2*nq]       their rates
-    W   = y[2*nq]          work done by all contact forces since t = 0 (J)
+    W   = y[2*nq]          work done by all contact forces and dampers since t = 0 (J)
+    D   = y[2*nq + 1]      energy dissipated by all dampers (contact damping included) (J)
 
     q[Q_X], q[Q_Y]         chassis mass-centre position (m)
     q[Q_PITCH]             chassis pitch, counter-clockwise (rad)
@@ -46,6 +47,22 @@ def pin_offset(n_wheels):
 def q_pin(n_wheels, b):
     """Index in q of the x coordinate of free pin b (y is the next one)."""
     return Q_ARM + n_wheels + 2 * (b - 1)
+
+
+Y_WORK = 0               # y[2 nq + Y_WORK]: W
+Y_DISSIPATED = 1         # y[2 nq + Y_DISSIPATED]: D
+N_Y_EXTRA = 2            # first-order components after (q, qd); the error test leaves them out
+
+
+@njit(**INLINE)
+def n_state(nq):
+    return 2 * nq + N_Y_EXTRA
+
+
+@njit(**INLINE)
+def nq_of(ny):
+    """Number of generalised coordinates of a state of length ny."""
+    return (ny - N_Y_EXTRA) // 2
 
 
 @njit(**INLINE)
@@ -121,7 +138,8 @@ NB_COUNT = 0             # column of the candidate count; entries follow in 1..c
 
 # --- run counters of the model arrays, ``counters`` -----------------------------------
 C_REBUILDS = 0           # candidate-list rebuilds
-N_COUNTERS = 1
+C_EVALUATIONS = 1        # evaluations of the track forces (stamps the pairs seen in contact)
+N_COUNTERS = 2
 
 # --- scalar parameters, ``par`` ---------------------------------------------------
 P_CHASSIS_MASS = 0
@@ -140,7 +158,24 @@ P_K_WHEEL = 12           # k_w
 P_K_GROUND = 13          # k_g
 P_GRAVITY = 14
 P_SKIN = 15              # neighbour-list margin (m); results do not depend on it
-N_PAR = 16
+# contact laws (model/contact_laws.py) and dampers; the paper: linear, no damping
+P_CONTACT_LAW = 16       # LAW_* code
+P_CONTACT_EXPONENT = 17  # n of the power law
+P_CONTACT_DAMPING = 18   # DAMPING_* code
+P_C_WHEEL = 19           # viscous coefficient of wheel-track contacts, 2 zeta sqrt(k_w m_pin) (N s/m)
+P_C_GROUND = 20          # viscous coefficient of ground- and corner-track contacts (N s/m)
+P_RESTITUTION_FACTOR = 21  # chi of the restitution-based laws
+P_DAMPING_RAMP = 22      # d_r (m)
+P_MIN_APPROACH = 23      # approach speed below which v0 counts as this (m/s)
+P_LINK_DAMPING = 24      # axial dashpot of every link (N s/m)
+N_PAR = 25
+
+# --- columns of the arm table, ``arms`` ----------------------------------------------
+ARMS_PX = 0              # pivot body point
+ARMS_PY = 1
+ARMS_PHI0 = 2            # torsion-bar free angle
+ARMS_DAMPING = 3         # rotary damper of the station (N m s/rad)
+N_ARMS_COLS = 4
 
 # --- per-evaluation diagnostics, ``diag`` -------------------------------------------
 D_STATUS = 0             # 0 ok, else a Status code found in this evaluation
@@ -159,7 +194,8 @@ D_CHASSIS_AY = 12
 D_MIN_TENSION = 13
 D_MAX_TENSION = 14
 D_OBSTACLE_FORCE = 15    # ground force on the track from obstacles: corners and every segment after the first (N)
-D_WHEEL = 16             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
+D_DISSIPATION = 16       # dD/dt: power dissipated by all dampers (W)
+D_WHEEL = 17             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
 @njit(**INLINE)

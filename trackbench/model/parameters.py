@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from . import layout as L
+from .contact_laws import DAMPING_VISCOUS, DAMPINGS, LAWS, restitution_factor
 
 
 def paper_vehicle():
@@ -29,6 +30,7 @@ def paper_vehicle():
         "pivot_spacing": 0.81,            # pivot i at first_pivot_x - i * spacing
         "front_track_end": [2.54, 0.0],   # body point where pin 0 is fixed (m)
         "rear_track_end": [-2.81, 0.0],   # body point where the last pin is fixed (m)
+        "arm_damping": [],                # rotary shock absorber per station (N m s/rad); [] = none
     }
 
 
@@ -43,6 +45,21 @@ def paper_track():
         "pad_ground": 0.02,               # h_g: centre line to ground-side surface (m)
         "wheel_stiffness": 1.0e8,         # k_w, Eq. (4) (N/m)
         "ground_stiffness": 1.0e8,        # k_g, Eq. (6) (N/m)
+        "link_damping": 0.0,              # axial dashpot parallel to each link spring (N s/m)
+    }
+
+
+def paper_contact():
+    """Contact laws: the paper's frictionless, undamped linear springs (section 2.2)."""
+    return {
+        "law": "linear",                  # or "power": F = k delta^exponent
+        "exponent": 1.5,                  # n of the power law (Hertz: 1.5)
+        "damping": "none",                # none, viscous, hunt_crossley, lankarani_nikravesh, flores
+        "damping_ratio": 0.0,             # zeta of the viscous law
+        "restitution": 1.0,               # e of the restitution-based laws
+        "damping_ramp": 2e-4,             # d_r: depth over which the viscous dashpot ramps in (m)
+        "min_approach_speed": 0.1,        # approach speeds below this count as this (m/s)
+        "geometry": "paper",              # or "continuous"
     }
 
 
@@ -68,7 +85,22 @@ def wheel_centres_body(vehicle):
     return pivots(vehicle) + vehicle["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
 
 
-def pack(vehicle, track, gravity):
+def _pack_contact(par, contact):
+    """The contact law's codes and coefficients (model/contact_laws.py) into par."""
+    par[L.P_CONTACT_LAW] = LAWS[contact["law"]]
+    par[L.P_CONTACT_EXPONENT] = contact["exponent"] if contact["law"] == "power" else 1.0
+    damping = DAMPINGS[contact["damping"]]
+    par[L.P_CONTACT_DAMPING] = damping
+    zeta = contact["damping_ratio"] if damping == DAMPING_VISCOUS else 0.0
+    # c = 2 zeta sqrt(k m_pin): the same rule for wheel, ground and corner contacts
+    par[L.P_C_WHEEL] = 2.0 * zeta * math.sqrt(par[L.P_K_WHEEL] * par[L.P_PIN_MASS])
+    par[L.P_C_GROUND] = 2.0 * zeta * math.sqrt(par[L.P_K_GROUND] * par[L.P_PIN_MASS])
+    par[L.P_RESTITUTION_FACTOR] = restitution_factor(damping, contact["restitution"])
+    par[L.P_DAMPING_RAMP] = contact["damping_ramp"]
+    par[L.P_MIN_APPROACH] = contact["min_approach_speed"]
+
+
+def pack(vehicle, track, gravity, contact=None):
     """Scalar parameter vector ``par`` (see layout.P_*) and the body-point tables."""
     par = np.zeros(L.N_PAR)
     par[L.P_CHASSIS_MASS] = vehicle["chassis_mass"]
@@ -87,6 +119,8 @@ def pack(vehicle, track, gravity):
     par[L.P_K_GROUND] = track["ground_stiffness"]
     par[L.P_GRAVITY] = gravity
     par[L.P_SKIN] = NEIGHBOUR_SKIN
+    par[L.P_LINK_DAMPING] = track.get("link_damping", 0.0)
+    _pack_contact(par, contact or paper_contact())
     ends = np.array([vehicle["front_track_end"], vehicle["rear_track_end"]], dtype=float)
     return par, pivots(vehicle), ends
 
@@ -94,3 +128,9 @@ def pack(vehicle, track, gravity):
 def total_mass(vehicle, track):
     return (vehicle["chassis_mass"] + vehicle["n_wheels"] * vehicle["arm_mass"]
             + (track["n_links"] - 1) * track["pin_mass"])
+
+
+def arm_damping(vehicle):
+    """One rotary damper coefficient per road-wheel station (zeros when none given)."""
+    c = vehicle.get("arm_damping") or []
+    return np.array(c, dtype=float) if len(c) else np.zeros(int(vehicle["n_wheels"]))

@@ -17,10 +17,12 @@ from .jit import INLINE, KERNEL
 from .kernels import track_loads
 from .kinematics import body_offset, positions
 from .layout import (
+    ARMS_DAMPING, ARMS_PHI0, D_DISSIPATION, Y_DISSIPATED, Y_WORK,
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH,
     P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH,
     Q_X, Q_Y, q_pin,
 )
+from .layout import nq_of
 
 
 @njit(**INLINE)
@@ -57,6 +59,7 @@ def _arms(q, qd, m, w, c, s, a, f, e):
     a00, a01, a02, a11, a12, a22 = a
     qx, qy, qt = f
     ke, e_tors, e_grav = e
+    dissipation = 0.0
     for i in range(m.arms.shape[0]):
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
@@ -81,15 +84,21 @@ def _arms(q, qd, m, w, c, s, a, f, e):
         qx += fx
         qy += fy
         qt += rpx * fx + rpy * fy
-        tors = -kt * (q[Q_ARM + i] - m.arms[i, 2])
+        tors = -kt * (q[Q_ARM + i] - m.arms[i, ARMS_PHI0])
         arm[i, ARM_BX] = ma * sx
         arm[i, ARM_BY] = ma * sy
         arm[i, ARM_BT] = ma * (rpx * sx + rpy * sy) + ia
         arm[i, ARM_Q] = sx * fx + sy * fy + tors
+        cd = m.arms[i, ARMS_DAMPING]
+        if cd != 0.0:
+            # rotary shock absorber: -c phi' on the arm, +c phi' on the chassis; phi is
+            # relative to the chassis, so the pair acts on phi alone
+            arm[i, ARM_Q] -= cd * qd[Q_ARM + i]
+            dissipation += cd * qd[Q_ARM + i] ** 2
         ke += 0.5 * ma * (w.wv[i, 0] ** 2 + w.wv[i, 1] ** 2) + 0.5 * ia * wb * wb
-        e_tors += 0.5 * kt * (q[Q_ARM + i] - m.arms[i, 2]) ** 2
+        e_tors += 0.5 * kt * (q[Q_ARM + i] - m.arms[i, ARMS_PHI0]) ** 2
         e_grav += ma * g * w.wc[i, 1]
-    return (a00, a01, a02, a11, a12, a22), (qx, qy, qt), (ke, e_tors, e_grav)
+    return (a00, a01, a02, a11, a12, a22), (qx, qy, qt), (ke, e_tors, e_grav), dissipation
 
 
 @njit(**INLINE)
@@ -140,14 +149,14 @@ def _pins(m, w, acc, ke, e_grav):
 
 @njit(**KERNEL)
 def reduced_rhs(y, m, w, ydot, diag):
-    """ydot = f(y) for y = (q, qd, W); fills diag (forces, energies, status)."""
-    nq = (y.shape[0] - 1) // 2
+    """ydot = f(y) for y = (q, qd, W, D); fills diag (forces, energies, status)."""
+    nq = nq_of(y.shape[0])
     q = y[:nq]
     qd = y[nq:2 * nq]
     c, s = positions(q, qd, m, w)
     track_loads(w, m, diag)
     a, f, e = _chassis(q, qd, m, w)
-    a, f, e = _arms(q, qd, m, w, c, s, a, f, e)
+    a, f, e, arm_dissipation = _arms(q, qd, m, w, c, s, a, f, e)
     d = m.par[P_ARM_MASS] * m.par[P_ARM_LENGTH] * m.par[P_ARM_LENGTH] + m.par[P_ARM_INERTIA]  # arm block: diagonal, constant
     ax, ay, at = _chassis_acceleration(w.arm, d, a, f)
     for k in range(nq):
@@ -161,7 +170,9 @@ def reduced_rhs(y, m, w, ydot, diag):
                           - w.arm[i, ARM_BT] * at) / d
     ke, e_tors, e_grav = e
     ke, e_grav = _pins(m, w, acc, ke, e_grav)
-    ydot[2 * nq] = diag[D_POWER]  # dW/dt
+    diag[D_DISSIPATION] += arm_dissipation
+    ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation  # dW/dt: contact forces and dampers
+    ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
     diag[D_E_KINETIC] = ke
     diag[D_E_TORSION] = e_tors
     diag[D_E_GRAVITY] = e_grav

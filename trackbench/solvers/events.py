@@ -25,6 +25,7 @@ from ..model.layout import (K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_L
                             NB_COUNT, P_ARM_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
                             Q_X, Q_Y, q_pin)
 from .hermite import coordinate, quintic_basis
+from ..model.layout import nq_of
 
 BISECTIONS = 24
 
@@ -136,7 +137,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     """Smallest t in (0, 1] at which some candidate contact starts or ends along the
     step's interpolant; 2.0 if none. Pairs whose validity (foot on link, wedge, acting
     segment) changes are left alone. ev: EventWork scratch."""
-    nq = (y0.shape[0] - 1) // 2
+    nq = nq_of(y0.shape[0])
     n_links = ev.pins0.shape[0] - 1
     place(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm)
     place(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm)

@@ -13,7 +13,8 @@ import numpy as np
 from numba import njit
 
 from ..model.jit import KERNEL
-from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0
+from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
+from ..model.kernels import remember_onsets
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
@@ -21,6 +22,7 @@ from .control import FAC_MAX, after_acceptance, after_rejection, before_step, fi
 from .events import first_contact_switch
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
+from ..model.layout import nq_of
 
 LoopWork = namedtuple("LoopWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
@@ -90,14 +92,15 @@ def _start(y0, m, w, lw, out):
     """t = 0: the first derivative (row 0 of K), the energy references, the first sample.
     Returns (status, e_ref, r_ref)."""
     ny = y0.shape[0]
-    nq = (ny - 1) // 2
+    nq = nq_of(ny)
     copy_into(lw.y, 0, y0)
     reduced_rhs(lw.y, m, w, lw.K[0], lw.diag)
     e_ref = energy_balance(lw.diag)
-    r_ref = energy_residual(lw.diag, lw.y[ny - 1])
+    r_ref = energy_residual(lw.diag, lw.y[2 * nq + Y_WORK])
     out.stats[S_E0] = e_ref - lw.diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
     init_peaks(out.peaks)
-    update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[ny - 1], e_ref, r_ref, False)
+    update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[2 * nq + Y_WORK], e_ref, r_ref, False)
+    remember_onsets(m, w)
     set_row(out.y, 0, lw.y)
     set_row(out.diag, 0, lw.diag)
     if lw.diag[D_STATUS] != 0.0:
@@ -120,7 +123,7 @@ def _stages(h, tab, m, w, lw):
 @njit(**KERNEL)
 def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
     """Output samples in (t, t_new] by Hermite interpolation; returns the new sample count."""
-    nq = (lw.y.shape[0] - 1) // 2
+    nq = nq_of(lw.y.shape[0])
     s = lw.K.shape[0] - 1
     while n_out < out.y.shape[0] and n_out * ctl.dt_out <= t_new * (1.0 + 1e-12):
         theta = min(1.0, (n_out * ctl.dt_out - t) / h)
@@ -146,7 +149,7 @@ def _accepted_status(lw):
 @njit(**KERNEL)
 def integrate(y0, ctl, tab, m, w, ev, lw, out):
     ny = y0.shape[0]
-    nq = (ny - 1) // 2
+    nq = nq_of(ny)
     s = tab.b.shape[0]
     status, e_ref, r_ref = _start(y0, m, w, lw, out)
     n_rhs = 1
@@ -165,7 +168,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
             break
         _stages(h, tab, m, w, lw)
         n_rhs += s
-        err = _error_norm(lw, tab, h, ctl.rtol, ctl.atol, ny - 1)
+        err = _error_norm(lw, tab, h, ctl.rtol, ctl.atol, 2 * nq)  # (q, qd) only: W and D follow them
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
             th = 2.0
@@ -180,8 +183,9 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         h_lo = min(h_lo, h)
         h_hi = max(h_hi, h)
         status = _accepted_status(lw)
-        update_peaks(out.peaks, t_new, lw.diag, lw.y_new[nq + Q_X], lw.y_new[ny - 1], e_ref, r_ref, at_switch)
+        update_peaks(out.peaks, t_new, lw.diag, lw.y_new[nq + Q_X], lw.y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
+        remember_onsets(m, w)
         n_new = _samples(t, t_new, h, n_out, ctl, m, w, lw, out)
         n_rhs += n_new - n_out
         n_out = n_new

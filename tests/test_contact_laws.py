@@ -1,0 +1,38 @@
+"""The contact laws in a drop test (tests/drop.py): a pin meets a pad at 1 m/s."""
+
+import math
+
+import pytest
+
+import trackbench as tb
+from drop import drop, restitution_law_closed_form, viscous_closed_form
+from trackbench.model.contact_laws import DAMPINGS, damping_ratio_for_restitution, restitution_factor
+from trackbench.presets import PAD_RESTITUTION
+
+E = (0.2, 0.5, 0.75, 0.9)
+
+
+@pytest.mark.parametrize("e", E)
+def test_viscous_law_matches_its_closed_form(e):
+    zeta = damping_ratio_for_restitution(e)
+    assert drop("viscous", zeta=zeta, ramp=1e-9) == pytest.approx(viscous_closed_form(zeta), rel=0.01)
+
+
+@pytest.mark.parametrize("law", ["hunt_crossley", "lankarani_nikravesh", "flores"])
+@pytest.mark.parametrize("e", E)
+def test_restitution_laws_match_the_energy_integral_for_any_exponent(law, e):
+    want = restitution_law_closed_form(restitution_factor(DAMPINGS[law], e))
+    assert drop(law, e=e, n=1.0) == pytest.approx(want, abs=1e-3)
+    assert drop(law, e=e, n=1.5, k=1e8 / math.sqrt(4.5e-4)) == pytest.approx(want, abs=1e-3)
+
+
+def test_damped_preset_rebounds_with_the_restitution_it_states():
+    sc = tb.Scenario.paper(preset="damped")
+    got = drop("viscous", zeta=sc["contact.damping_ratio"], ramp=sc["contact.damping_ramp"])
+    assert got == pytest.approx(PAD_RESTITUTION, rel=0.02)
+
+
+def test_no_damping_is_elastic_and_force_never_pulls():
+    assert drop("none") == pytest.approx(1.0, abs=1e-6)
+    # a strongly damped viscous contact would pull on the way out; it lets go instead
+    assert drop("viscous", zeta=0.9, ramp=1e-9) > 0.0

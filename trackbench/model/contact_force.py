@@ -1,0 +1,31 @@
+"""The normal-force law of every penalty contact, compiled (contact_laws.py has the
+formulas, their sources and the codes)."""
+
+from numba import njit
+
+from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, LAW_POWER
+from .jit import INLINE
+
+
+@njit(**INLINE)
+def elastic(law, k, n, delta):
+    """(force, stored energy) of the pad spring at compression delta > 0."""
+    if law == LAW_POWER:
+        f = k * delta ** n
+        return f, f * delta / (n + 1.0)
+    return k * delta, 0.5 * k * delta ** 2
+
+
+@njit(**INLINE)
+def normal_force(law, damping, k, n, c, chi, ramp, delta, delta_dot, v0):
+    """(force, stored energy, dissipated power) of one contact at compression delta > 0.
+    c: viscous coefficient; chi: restitution factor (restitution_factor); ramp: d_r."""
+    f_el, energy = elastic(law, k, n, delta)
+    if damping == DAMPING_NONE:
+        return f_el, energy, 0.0
+    if damping == DAMPING_VISCOUS:
+        f = f_el + c * min(delta / ramp, 1.0) * delta_dot
+    else:
+        f = f_el * (1.0 + chi * delta_dot / v0)
+    f = max(f, 0.0)
+    return f, energy, (f - f_el) * delta_dot
