@@ -14,13 +14,15 @@ import numpy as np
 from numba import njit
 
 from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
-from .gaps import in_pin_wedge, link_coords, link_frames, pin_ground_selection, pin_segment_acts, segment_coords
+from .gaps import (link_frames, pin_ground_selection, pin_segment_valid, point_on_link, point_on_segment,
+                   segment_coords, wedge)
 from .jit import INLINE, KERNEL
 from .layout import (
     C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY,
     D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND,
     K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND,
-    P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, diag_tension,
+    P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
+    diag_tension,
 )
 
 
@@ -90,36 +92,30 @@ def build_neighbours(apos, wc, m):
 
 
 @njit(**INLINE)
-def _moved(points, ref, first, lim):
-    """Has any point moved more than sqrt(lim) from ref[first + k]?"""
-    stale = False
-    for k in range(points.shape[0]):
-        dx = points[k, 0] - ref[first + k, 0]
-        dy = points[k, 1] - ref[first + k, 1]
-        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
-    return stale
-
-
-@njit(**INLINE)
-def _remember(points, ref, first):
-    for k in range(points.shape[0]):
-        ref[first + k, 0] = points[k, 0]
-        ref[first + k, 1] = points[k, 1]
-
-
-@njit(**INLINE)
 def refresh_neighbours(w, m):
     """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
     (so the lists always hold every pair that can touch: results equal a full search)."""
+    apos, wc, ref = w.apos, w.wc, m.ref
     half = 0.5 * m.par[P_SKIN]
     lim = half * half
-    n_pins = w.apos.shape[0]
-    stale = _moved(w.apos, m.ref, 0, lim)
-    stale |= _moved(w.wc, m.ref, n_pins, lim)
+    n_pins = apos.shape[0]
+    stale = False
+    for b in range(n_pins):
+        dx = apos[b, 0] - ref[b, 0]
+        dy = apos[b, 1] - ref[b, 1]
+        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
+    for i in range(wc.shape[0]):
+        dx = wc[i, 0] - ref[n_pins + i, 0]
+        dy = wc[i, 1] - ref[n_pins + i, 1]
+        stale |= not (dx * dx + dy * dy <= lim)
     if stale:
-        build_neighbours(w.apos, w.wc, m)
-        _remember(w.apos, m.ref, 0)
-        _remember(w.wc, m.ref, n_pins)
+        build_neighbours(apos, wc, m)
+        for b in range(n_pins):
+            ref[b, 0] = apos[b, 0]
+            ref[b, 1] = apos[b, 1]
+        for i in range(wc.shape[0]):
+            ref[n_pins + i, 0] = wc[i, 0]
+            ref[n_pins + i, 1] = wc[i, 1]
         m.counters[C_REBUILDS] += 1
 
 
@@ -136,10 +132,19 @@ def link_tensions(w, par, diag):
     energy = 0.0
     tmin = np.inf
     tmax = -np.inf
-    link_frames(apos, lk)
-    for b in range(apos.shape[0] - 1):
-        tx = lk[b, 0]
-        ty = lk[b, 1]
+    n_links = apos.shape[0] - 1
+    for b in range(n_links):  # lengths first: a loop of square roots that vectorises
+        dx = apos[b + 1, 0] - apos[b, 0]
+        dy = apos[b + 1, 1] - apos[b, 1]
+        lk[b, 0] = dx
+        lk[b, 1] = dy
+        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
+    for b in range(n_links):
+        inv = 1.0 / lk[b, 2]
+        tx = lk[b, 0] * inv
+        ty = lk[b, 1] * inv
+        lk[b, 0] = tx
+        lk[b, 1] = ty
         stretch = lk[b, 2] - l0
         tension = k * stretch
         diag[t_off + b] = tension
@@ -169,72 +174,59 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
 
 
 @njit(**INLINE)
-def _wheel_on_links(i, w, m, k, rho, diag, acc):
-    """Road wheel i against the links (Fig. 3, Eq. 4). acc = (fx, fy, energy, power) is
-    carried through, not summed apart and added: every sum keeps the order of one loop."""
-    apos, lk, wc = w.apos, w.lk, w.wc
-    fwx, fwy, energy, power = acc
-    row = m.nbr_rows[K_WHEEL_LINK] + i
-    for j in range(m.nbr[row, NB_COUNT]):
-        b = m.nbr[row, 1 + j]
-        d0, s = link_coords(wc[i, 0], wc[i, 1], apos, lk, b)
-        if d0 < 0.0 or d0 > lk[b, 2]:
-            continue
-        if s >= rho or s <= -rho:
-            continue
-        if s < 0.0:
-            diag[D_STATUS] = WHEEL_THROUGH_TRACK
-            continue
-        p = k * (rho - s)  # Eq. (4)
-        fx = p * lk[b, 1]
-        fy = -p * lk[b, 0]
-        fwx += fx
-        fwy += fy
-        energy += 0.5 * k * (rho - s) ** 2
-        power += fx * w.wv[i, 0] + fy * w.wv[i, 1]
-        power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], -fx, -fy)
-    return fwx, fwy, energy, power
-
-
-@njit(**INLINE)
-def _wheel_on_pins(i, w, m, k, rho, acc):
-    """Road wheel i against free pins in the wedge (Fig. 4); acc as in _wheel_on_links."""
-    apos, avel, wc = w.apos, w.avel, w.wc
-    fwx, fwy, energy, power = acc
-    row = m.nbr_rows[K_WHEEL_PIN] + i
-    for j in range(m.nbr[row, NB_COUNT]):
-        b = m.nbr[row, 1 + j]
-        if not in_pin_wedge(wc[i, 0], wc[i, 1], apos, w.lk, b, True):
-            continue
-        dx = wc[i, 0] - apos[b, 0]
-        dy = wc[i, 1] - apos[b, 1]
-        dist = math.sqrt(dx * dx + dy * dy)
-        if dist >= rho:
-            continue
-        p = k * (rho - dist)
-        fx = p * dx / dist
-        fy = p * dy / dist
-        fwx += fx
-        fwy += fy
-        w.fpin[b, 0] -= fx
-        w.fpin[b, 1] -= fy
-        energy += 0.5 * k * (rho - dist) ** 2
-        power += fx * (w.wv[i, 0] - avel[b, 0]) + fy * (w.wv[i, 1] - avel[b, 1])
-    return fwx, fwy, energy, power
-
-
-@njit(**INLINE)
 def wheel_contacts(w, m, diag):
     """Every road wheel against the track: links, then pins in the wedge."""
+    apos, avel, lk, wc, wv, fpin, nbr, fwheel = w.apos, w.avel, w.lk, w.wc, w.wv, w.fpin, m.nbr, w.fwheel
     k = m.par[P_K_WHEEL]
     rho = m.par[P_WHEEL_RADIUS] + m.par[P_PAD_WHEEL]
+    r0 = m.nbr_rows[K_WHEEL_LINK]
+    r1 = m.nbr_rows[K_WHEEL_PIN]
     energy = 0.0
     power = 0.0
-    for i in range(w.wc.shape[0]):
-        acc = _wheel_on_links(i, w, m, k, rho, diag, (0.0, 0.0, energy, power))
-        fwx, fwy, energy, power = _wheel_on_pins(i, w, m, k, rho, acc)
-        w.fwheel[i, 0] = fwx
-        w.fwheel[i, 1] = fwy
+    for i in range(fwheel.shape[0]):
+        fwx = 0.0
+        fwy = 0.0
+        row = r0 + i
+        for j in range(nbr[row, NB_COUNT]):
+            b = nbr[row, 1 + j]
+            d0, s = point_on_link(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
+            if d0 < 0.0 or d0 > lk[b, 2]:
+                continue
+            if s >= rho or s <= -rho:
+                continue
+            if s < 0.0:
+                diag[D_STATUS] = WHEEL_THROUGH_TRACK
+                continue
+            p = k * (rho - s)  # Eq. (4)
+            fx = p * lk[b, 1]
+            fy = -p * lk[b, 0]
+            fwx += fx
+            fwy += fy
+            energy += 0.5 * k * (rho - s) ** 2
+            power += fx * wv[i, 0] + fy * wv[i, 1]
+            power += _link_load(fpin, avel, b, d0, lk[b, 2], -fx, -fy)
+        row = r1 + i
+        for j in range(nbr[row, NB_COUNT]):
+            b = nbr[row, 1 + j]
+            if not wedge(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1],
+                         True):
+                continue
+            dx = wc[i, 0] - apos[b, 0]
+            dy = wc[i, 1] - apos[b, 1]
+            dist = math.sqrt(dx * dx + dy * dy)
+            if dist >= rho:
+                continue
+            p = k * (rho - dist)
+            fx = p * dx / dist
+            fy = p * dy / dist
+            fwx += fx
+            fwy += fy
+            fpin[b, 0] -= fx
+            fpin[b, 1] -= fy
+            energy += 0.5 * k * (rho - dist) ** 2
+            power += fx * (wv[i, 0] - avel[b, 0]) + fy * (wv[i, 1] - avel[b, 1])
+        fwheel[i, 0] = fwx
+        fwheel[i, 1] = fwy
         diag[D_WHEEL + 2 * i] = fwx
         diag[D_WHEEL + 2 * i + 1] = fwy
     diag[D_E_PAD_WHEEL] = energy
@@ -247,105 +239,94 @@ def _pins_on_ground(w, m, k, hg, acc):
     a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
     energy, power, obstacle force), carried through in the order of one loop. Every
     segment after the first (the ground the vehicle starts on) belongs to an obstacle."""
-    apos, seg = w.apos, m.seg
+    apos, avel, fpin, seg, nbr = w.apos, w.avel, w.fpin, m.seg, m.nbr
+    first = m.nbr_rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle = acc
     for b in range(1, apos.shape[0] - 1):
-        row = m.nbr_rows[K_PIN_GROUND] + b
-        inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, m.nbr, row, hg)
+        row = first + b
+        inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, nbr, row, hg)
         if best == -np.inf:
             continue
-        for j in range(m.nbr[row, NB_COUNT]):
-            sj = m.nbr[row, 1 + j]
-            lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, sj)
-            if not pin_segment_acts(lam, s, seg, sj, hg, inside, n_below, best):
+        for j in range(nbr[row, NB_COUNT]):
+            sj = nbr[row, 1 + j]
+            lam, s = point_on_segment(apos[b, 0], apos[b, 1], seg[sj, SEG_X0], seg[sj, SEG_Y0], seg[sj, SEG_TX],
+                                      seg[sj, SEG_TY], seg[sj, SEG_NX], seg[sj, SEG_NY])
+            if s >= hg or not pin_segment_valid(lam, s, seg[sj, SEG_LENGTH], inside, n_below, best):
                 continue
             p = k * (hg - s)  # Eq. (6)
             fx = p * seg[sj, SEG_NX]
             fy = p * seg[sj, SEG_NY]
-            w.fpin[b, 0] += fx
-            w.fpin[b, 1] += fy
+            fpin[b, 0] += fx
+            fpin[b, 1] += fy
             gx += fx
             gy += fy
             energy += 0.5 * k * (hg - s) ** 2
-            power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
+            power += fx * avel[b, 0] + fy * avel[b, 1]
             if sj > 0:
                 obstacle += p
     return gx, gy, corner_force, energy, power, obstacle
 
 
 @njit(**INLINE)
-def _corner_on_links(c, w, m, k, hg, diag, acc):
-    """Ground corner c against the links (Fig. 5 right), split by Eq. (7); acc as above."""
-    apos, lk = w.apos, w.lk
-    cx = m.corners[c, 0]
-    cy = m.corners[c, 1]
+def _corners(w, m, k, hg, diag, acc):
+    """Every ground corner against the links (Fig. 5 right, split by Eq. 7) and against
+    free pins in the wedge (Fig. 6); acc as in _pins_on_ground."""
+    apos, avel, lk, fpin, nbr, corners = w.apos, w.avel, w.lk, w.fpin, m.nbr, m.corners
+    r_link = m.nbr_rows[K_CORNER_LINK]
+    r_pin = m.nbr_rows[K_CORNER_PIN]
     hw = m.par[P_PAD_WHEEL]
     gx, gy, corner_force, energy, power, obstacle = acc
-    row = m.nbr_rows[K_CORNER_LINK] + c
-    for j in range(m.nbr[row, NB_COUNT]):
-        b = m.nbr[row, 1 + j]
-        d0, s_in = link_coords(cx, cy, apos, lk, b)
-        if d0 < 0.0 or d0 > lk[b, 2]:
-            continue
-        s = -s_in  # along the outer normal -n_inner
-        if s >= hg or s <= -hw:
-            continue
-        if s < 0.0:
-            diag[D_STATUS] = CORNER_THROUGH_TRACK
-            continue
-        p = k * (hg - s)
-        fx = p * lk[b, 1]
-        fy = -p * lk[b, 0]
-        gx += fx
-        gy += fy
-        corner_force += p
-        energy += 0.5 * k * (hg - s) ** 2
-        power += _link_load(w.fpin, w.avel, b, d0, lk[b, 2], fx, fy)
-        obstacle += p
-    return gx, gy, corner_force, energy, power, obstacle
-
-
-@njit(**INLINE)
-def _corner_on_pins(c, w, m, k, hg, acc):
-    """Ground corner c against free pins in the wedge (Fig. 6); acc as above."""
-    apos = w.apos
-    cx = m.corners[c, 0]
-    cy = m.corners[c, 1]
-    gx, gy, corner_force, energy, power, obstacle = acc
-    row = m.nbr_rows[K_CORNER_PIN] + c
-    for j in range(m.nbr[row, NB_COUNT]):
-        b = m.nbr[row, 1 + j]
-        if not in_pin_wedge(cx, cy, apos, w.lk, b, False):
-            continue
-        dx = cx - apos[b, 0]
-        dy = cy - apos[b, 1]
-        dist = math.sqrt(dx * dx + dy * dy)
-        if dist >= hg:
-            continue
-        p = k * (hg - dist)
-        fx = -p * dx / dist
-        fy = -p * dy / dist
-        w.fpin[b, 0] += fx
-        w.fpin[b, 1] += fy
-        gx += fx
-        gy += fy
-        corner_force += p
-        energy += 0.5 * k * (hg - dist) ** 2
-        power += fx * w.avel[b, 0] + fy * w.avel[b, 1]
-        obstacle += p
+    for c in range(corners.shape[0]):
+        cx = corners[c, 0]
+        cy = corners[c, 1]
+        for j in range(nbr[r_link + c, NB_COUNT]):
+            b = nbr[r_link + c, 1 + j]
+            d0, s_in = point_on_link(cx, cy, apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
+            s = -s_in  # along the outer normal -n_inner
+            if d0 < 0.0 or d0 > lk[b, 2] or s >= hg or s <= -hw:
+                continue
+            if s < 0.0:
+                diag[D_STATUS] = CORNER_THROUGH_TRACK
+                continue
+            p = k * (hg - s)
+            fx = p * lk[b, 1]
+            fy = -p * lk[b, 0]
+            gx += fx
+            gy += fy
+            corner_force += p
+            energy += 0.5 * k * (hg - s) ** 2
+            power += _link_load(fpin, avel, b, d0, lk[b, 2], fx, fy)
+            obstacle += p
+        for j in range(nbr[r_pin + c, NB_COUNT]):
+            b = nbr[r_pin + c, 1 + j]
+            if not wedge(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1], False):
+                continue
+            dx = cx - apos[b, 0]
+            dy = cy - apos[b, 1]
+            dist = math.sqrt(dx * dx + dy * dy)
+            if dist >= hg:
+                continue
+            p = k * (hg - dist)
+            fx = -p * dx / dist
+            fy = -p * dy / dist
+            fpin[b, 0] += fx
+            fpin[b, 1] += fy
+            gx += fx
+            gy += fy
+            corner_force += p
+            energy += 0.5 * k * (hg - dist) ** 2
+            power += fx * avel[b, 0] + fy * avel[b, 1]
+            obstacle += p
     return gx, gy, corner_force, energy, power, obstacle
 
 
 @njit(**INLINE)
 def ground_contacts(w, m, diag):
-    """The track against the ground: pins on segments, then each corner on links and pins."""
+    """The track against the ground: pins on segments, then the corners."""
     k = m.par[P_K_GROUND]
     hg = m.par[P_PAD_GROUND]
     acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-    for c in range(m.corners.shape[0]):
-        acc = _corner_on_links(c, w, m, k, hg, diag, acc)
-        acc = _corner_on_pins(c, w, m, k, hg, acc)
-    gx, gy, corner_force, energy, power, obstacle = acc
+    gx, gy, corner_force, energy, power, obstacle = _corners(w, m, k, hg, diag, acc)
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy

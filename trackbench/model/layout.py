@@ -142,6 +142,11 @@ P_GRAVITY = 14
 P_SKIN = 15              # neighbour-list margin (m); results do not depend on it
 N_PAR = 16
 
+# --- columns of the arm table, ``arms`` ----------------------------------------------
+ARMS_PX = 0              # pivot body point
+ARMS_PY = 1
+ARMS_PHI0 = 2            # torsion-bar free angle
+
 # --- per-evaluation diagnostics, ``diag`` -------------------------------------------
 D_STATUS = 0             # 0 ok, else a Status code found in this evaluation
 D_POWER = 1              # dW/dt: power of all contact forces (W)

@@ -17,6 +17,7 @@ from .jit import INLINE, KERNEL
 from .kernels import track_loads
 from .kinematics import body_offset, positions
 from .layout import (
+    ARMS_PHI0,
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH,
     P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH,
     Q_X, Q_Y, q_pin,
@@ -24,43 +25,38 @@ from .layout import (
 
 
 @njit(**INLINE)
-def _chassis(q, qd, m, w):
-    """The chassis alone: its mass block, the track-end pulls and gravity on it, its
-    kinetic energy and gravity potential."""
-    par, fpin, apos = m.par, w.fpin, w.apos
+def _chassis_and_arms(q, qd, m, w, c, s):
+    """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), every arm +
+    road wheel added; the coupling B_i of each arm and its generalised force (torsion bar
+    included) into w.arm. Returns (A, f, (kinetic, torsion, gravity energies))."""
+    par, arm, arms, fwheel, wv, wc, fpin, apos = m.par, w.arm, m.arms, w.fwheel, w.wv, w.wc, w.fpin, w.apos
     mc = par[P_CHASSIS_MASS]
-    g = par[P_GRAVITY]
-    last = apos.shape[0] - 1
-    a = (mc, 0.0, 0.0, mc, 0.0, par[P_CHASSIS_INERTIA])
-    qt = 0.0
-    for b in (0, last):
-        rx = apos[b, 0] - q[Q_X]
-        ry = apos[b, 1] - q[Q_Y]
-        qt += rx * fpin[b, 1] - ry * fpin[b, 0]
-    f = (fpin[0, 0] + fpin[last, 0], fpin[0, 1] + fpin[last, 1] - mc * g, qt)
-    om = qd[Q_PITCH]
-    e = (0.5 * mc * (qd[Q_X] ** 2 + qd[Q_Y] ** 2) + 0.5 * par[P_CHASSIS_INERTIA] * om * om, 0.0, mc * g * q[Q_Y])
-    return a, f, e
-
-
-@njit(**INLINE)
-def _arms(q, qd, m, w, c, s, a, f, e):
-    """Add every arm + road wheel to the chassis block; fill the arm columns of w.arm with
-    its coupling B_i to (x, y, pitch) and its generalised force (torsion bar included)."""
-    par, arm = m.par, w.arm
     ma = par[P_ARM_MASS]
     ia = par[P_ARM_INERTIA]
     la = par[P_ARM_LENGTH]
     kt = par[P_TORSION_STIFFNESS]
     g = par[P_GRAVITY]
     om = qd[Q_PITCH]
-    a00, a01, a02, a11, a12, a22 = a
-    qx, qy, qt = f
-    ke, e_tors, e_grav = e
-    for i in range(m.arms.shape[0]):
+    last = apos.shape[0] - 1
+    a00 = mc
+    a11 = mc
+    a22 = par[P_CHASSIS_INERTIA]
+    a01 = 0.0
+    a02 = 0.0
+    a12 = 0.0
+    qx = fpin[0, 0] + fpin[last, 0]
+    qy = fpin[0, 1] + fpin[last, 1] - mc * g
+    qt = 0.0
+    for e in range(2):
+        b = 0 if e == 0 else last
+        qt += (apos[b, 0] - q[Q_X]) * fpin[b, 1] - (apos[b, 1] - q[Q_Y]) * fpin[b, 0]
+    ke = 0.5 * mc * (qd[Q_X] ** 2 + qd[Q_Y] ** 2) + 0.5 * a22 * om * om
+    e_tors = 0.0
+    e_grav = mc * g * q[Q_Y]
+    for i in range(arms.shape[0]):
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
-        px, py = body_offset(c, s, m.arms[i, 0], m.arms[i, 1])
+        px, py = body_offset(c, s, arms[i, 0], arms[i, 1])
         rx = px + la * cb
         ry = py + la * sb
         rpx = -ry           # d(w)/d(pitch)
@@ -69,10 +65,8 @@ def _arms(q, qd, m, w, c, s, a, f, e):
         sy = la * cb
         wb = om + qd[Q_ARM + i]
         # velocity-dependent (centripetal) acceleration of the wheel centre
-        avx = -om * om * px - wb * wb * la * cb
-        avy = -om * om * py - wb * wb * la * sb
-        fx = w.fwheel[i, 0] - ma * avx
-        fy = w.fwheel[i, 1] - ma * g - ma * avy
+        fx = fwheel[i, 0] - ma * (-om * om * px - wb * wb * la * cb)
+        fy = fwheel[i, 1] - ma * g - ma * (-om * om * py - wb * wb * la * sb)
         a00 += ma
         a11 += ma
         a02 += ma * rpx
@@ -81,14 +75,13 @@ def _arms(q, qd, m, w, c, s, a, f, e):
         qx += fx
         qy += fy
         qt += rpx * fx + rpy * fy
-        tors = -kt * (q[Q_ARM + i] - m.arms[i, 2])
         arm[i, ARM_BX] = ma * sx
         arm[i, ARM_BY] = ma * sy
         arm[i, ARM_BT] = ma * (rpx * sx + rpy * sy) + ia
-        arm[i, ARM_Q] = sx * fx + sy * fy + tors
-        ke += 0.5 * ma * (w.wv[i, 0] ** 2 + w.wv[i, 1] ** 2) + 0.5 * ia * wb * wb
-        e_tors += 0.5 * kt * (q[Q_ARM + i] - m.arms[i, 2]) ** 2
-        e_grav += ma * g * w.wc[i, 1]
+        arm[i, ARM_Q] = sx * fx + sy * fy - kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0])
+        ke += 0.5 * ma * (wv[i, 0] ** 2 + wv[i, 1] ** 2) + 0.5 * ia * wb * wb
+        e_tors += 0.5 * kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0]) ** 2
+        e_grav += ma * g * wc[i, 1]
     return (a00, a01, a02, a11, a12, a22), (qx, qy, qt), (ke, e_tors, e_grav)
 
 
@@ -126,15 +119,16 @@ def _chassis_acceleration(arm, d, a, f):
 @njit(**INLINE)
 def _pins(m, w, acc, ke, e_grav):
     """Free pins: point masses under tension, contact forces and gravity."""
+    apos, avel, fpin = w.apos, w.avel, w.fpin
     mp = m.par[P_PIN_MASS]
     g = m.par[P_GRAVITY]
     nw = m.arms.shape[0]
-    for b in range(1, w.apos.shape[0] - 1):
+    for b in range(1, apos.shape[0] - 1):
         k = q_pin(nw, b)
-        acc[k] = w.fpin[b, 0] / mp
-        acc[k + 1] = w.fpin[b, 1] / mp - g
-        ke += 0.5 * mp * (w.avel[b, 0] ** 2 + w.avel[b, 1] ** 2)
-        e_grav += mp * g * w.apos[b, 1]
+        acc[k] = fpin[b, 0] / mp
+        acc[k + 1] = fpin[b, 1] / mp - g
+        ke += 0.5 * mp * (avel[b, 0] ** 2 + avel[b, 1] ** 2)
+        e_grav += mp * g * apos[b, 1]
     return ke, e_grav
 
 
@@ -146,8 +140,7 @@ def reduced_rhs(y, m, w, ydot, diag):
     qd = y[nq:2 * nq]
     c, s = positions(q, qd, m, w)
     track_loads(w, m, diag)
-    a, f, e = _chassis(q, qd, m, w)
-    a, f, e = _arms(q, qd, m, w, c, s, a, f, e)
+    a, f, e = _chassis_and_arms(q, qd, m, w, c, s)
     d = m.par[P_ARM_MASS] * m.par[P_ARM_LENGTH] * m.par[P_ARM_LENGTH] + m.par[P_ARM_INERTIA]  # arm block: diagonal, constant
     ax, ay, at = _chassis_acceleration(w.arm, d, a, f)
     for k in range(nq):
@@ -156,9 +149,9 @@ def reduced_rhs(y, m, w, ydot, diag):
     acc[Q_X] = ax
     acc[Q_Y] = ay
     acc[Q_PITCH] = at
-    for i in range(m.arms.shape[0]):
-        acc[Q_ARM + i] = (w.arm[i, ARM_Q] - w.arm[i, ARM_BX] * ax - w.arm[i, ARM_BY] * ay
-                          - w.arm[i, ARM_BT] * at) / d
+    arm = w.arm
+    for i in range(arm.shape[0]):
+        acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
     ke, e_tors, e_grav = e
     ke, e_grav = _pins(m, w, acc, ke, e_grav)
     ydot[2 * nq] = diag[D_POWER]  # dW/dt

@@ -12,7 +12,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ..model.jit import KERNEL
+from ..model.jit import INLINE, KERNEL
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL
@@ -39,7 +39,7 @@ def loop_arrays(stages, ny, n_diag):
                     np.empty(ny), np.empty(ny), np.empty(n_diag))
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _combine(y, h, w, K, m, out):
     """out = y + h * sum_j<m w_j K_j (zero weights skipped). K is indexed in 2D, not by
     row views: a view per stage costs reference counting (~6 % of a run)."""
@@ -53,7 +53,7 @@ def _combine(y, h, w, K, m, out):
                 out[k] += c * K[j, k]
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _error_norm(lw, tab, h, rtol, atol, n):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
@@ -105,7 +105,7 @@ def _start(y0, m, w, lw, out):
     return SUCCESSFUL, e_ref, r_ref
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _stages(h, tab, m, w, lw):
     """One step of the pair from lw.y: stages into K, the new state into y_new and its
     derivative into the last row of K (first same as last)."""
@@ -117,7 +117,7 @@ def _stages(h, tab, m, w, lw):
     reduced_rhs(lw.y_new, m, w, lw.K[s], lw.diag)
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
     """Output samples in (t, t_new] by Hermite interpolation; returns the new sample count."""
     nq = (lw.y.shape[0] - 1) // 2
@@ -131,7 +131,7 @@ def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
     return n_out
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _accepted_status(lw):
     """NAN for a state that diverged, unless the evaluation found why (diag's status)."""
     status = SUCCESSFUL
