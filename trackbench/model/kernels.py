@@ -66,10 +66,9 @@ def _near_pins(px, py, apos, reach, nbr, row):
 
 
 @njit(**KERNEL)
-def build_neighbours(apos, wc, m):
+def build_neighbours(apos, wc, par, seg, corners, nbr, rows):
     """Fill the candidate lists: every pair that could touch while no pin or wheel
-    moves more than half the skin from where it is now."""
-    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
+    moves more than half the skin from where it is now (rows: ModelArrays.nbr_rows)."""
     skin = par[P_SKIN]
     hg = par[P_PAD_GROUND]
     reach_w = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL] + skin
@@ -92,11 +91,10 @@ def build_neighbours(apos, wc, m):
 
 
 @njit(**INLINE)
-def refresh_neighbours(w, m):
+def refresh_neighbours(apos, wc, par, seg, corners, nbr, rows, ref, counters):
     """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
     (so the lists always hold every pair that can touch: results equal a full search)."""
-    apos, wc, ref = w.apos, w.wc, m.ref
-    half = 0.5 * m.par[P_SKIN]
+    half = 0.5 * par[P_SKIN]
     lim = half * half
     n_pins = apos.shape[0]
     stale = False
@@ -109,24 +107,22 @@ def refresh_neighbours(w, m):
         dy = wc[i, 1] - ref[n_pins + i, 1]
         stale |= not (dx * dx + dy * dy <= lim)
     if stale:
-        build_neighbours(apos, wc, m)
+        build_neighbours(apos, wc, par, seg, corners, nbr, rows)
         for b in range(n_pins):
             ref[b, 0] = apos[b, 0]
             ref[b, 1] = apos[b, 1]
         for i in range(wc.shape[0]):
             ref[n_pins + i, 0] = wc[i, 0]
             ref[n_pins + i, 1] = wc[i, 1]
-        m.counters[C_REBUILDS] += 1
+        counters[C_REBUILDS] += 1
 
 
 @njit(**INLINE)
-def link_tensions(w, par, diag):
+def link_tensions(apos, par, lk, fpin, diag, t_off):
     """Eq. (8): T = k_tau (|a_b - a_(b+1)| - L0), linear both ways; sets fpin to the pull
-    on every pin, stores t and length in lk and T in diag."""
-    apos, lk, fpin = w.apos, w.lk, w.fpin
+    on every pin, stores t and length in lk and T in diag[t_off + b]."""
     k = par[P_LINK_STIFFNESS]
     l0 = par[P_LINK_LENGTH]
-    t_off = diag_tension(w.wc.shape[0])
     fpin[0, 0] = 0.0
     fpin[0, 1] = 0.0
     energy = 0.0
@@ -174,13 +170,13 @@ def _link_load(fpin, avel, b, d0, length, fx, fy):
 
 
 @njit(**INLINE)
-def wheel_contacts(w, m, diag):
-    """Every road wheel against the track: links, then pins in the wedge."""
-    apos, avel, lk, wc, wv, fpin, nbr, fwheel = w.apos, w.avel, w.lk, w.wc, w.wv, w.fpin, m.nbr, w.fwheel
-    k = m.par[P_K_WHEEL]
-    rho = m.par[P_WHEEL_RADIUS] + m.par[P_PAD_WHEEL]
-    r0 = m.nbr_rows[K_WHEEL_LINK]
-    r1 = m.nbr_rows[K_WHEEL_PIN]
+def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag):
+    """Every road wheel against the track: links (Fig. 3, Eq. 4), then free pins in the
+    wedge (Fig. 4)."""
+    k = par[P_K_WHEEL]
+    rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
+    r0 = rows[K_WHEEL_LINK]
+    r1 = rows[K_WHEEL_PIN]
     energy = 0.0
     power = 0.0
     for i in range(fwheel.shape[0]):
@@ -234,13 +230,14 @@ def wheel_contacts(w, m, diag):
 
 
 @njit(**INLINE)
-def _pins_on_ground(w, m, k, hg, acc):
+def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
     energy, power, obstacle force), carried through in the order of one loop. Every
     segment after the first (the ground the vehicle starts on) belongs to an obstacle."""
-    apos, avel, fpin, seg, nbr = w.apos, w.avel, w.fpin, m.seg, m.nbr
-    first = m.nbr_rows[K_PIN_GROUND]
+    k = par[P_K_GROUND]
+    hg = par[P_PAD_GROUND]
+    first = rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle = acc
     for b in range(1, apos.shape[0] - 1):
         row = first + b
@@ -268,13 +265,14 @@ def _pins_on_ground(w, m, k, hg, acc):
 
 
 @njit(**INLINE)
-def _corners(w, m, k, hg, diag, acc):
+def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, acc):
     """Every ground corner against the links (Fig. 5 right, split by Eq. 7) and against
     free pins in the wedge (Fig. 6); acc as in _pins_on_ground."""
-    apos, avel, lk, fpin, nbr, corners = w.apos, w.avel, w.lk, w.fpin, m.nbr, m.corners
-    r_link = m.nbr_rows[K_CORNER_LINK]
-    r_pin = m.nbr_rows[K_CORNER_PIN]
-    hw = m.par[P_PAD_WHEEL]
+    k = par[P_K_GROUND]
+    hg = par[P_PAD_GROUND]
+    r_link = rows[K_CORNER_LINK]
+    r_pin = rows[K_CORNER_PIN]
+    hw = par[P_PAD_WHEEL]
     gx, gy, corner_force, energy, power, obstacle = acc
     for c in range(corners.shape[0]):
         cx = corners[c, 0]
@@ -321,12 +319,10 @@ def _corners(w, m, k, hg, diag, acc):
 
 
 @njit(**INLINE)
-def ground_contacts(w, m, diag):
+def ground_contacts(apos, avel, lk, fpin, par, seg, corners, nbr, rows, diag):
     """The track against the ground: pins on segments, then the corners."""
-    k = m.par[P_K_GROUND]
-    hg = m.par[P_PAD_GROUND]
-    acc = _pins_on_ground(w, m, k, hg, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-    gx, gy, corner_force, energy, power, obstacle = _corners(w, m, k, hg, diag, acc)
+    acc = _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    gx, gy, corner_force, energy, power, obstacle = _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, acc)
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy
@@ -341,9 +337,11 @@ def track_loads(w, m, diag):
     overwritten, tension first): tension and contact forces on the pins (w.fpin, pins 0
     and n_links included), contact forces on the wheels (w.fwheel), energies, power and
     status in diag. Gravity is left to the caller."""
+    apos, avel, fpin, wc, wv, fwheel, lk = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.lk
+    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
-    refresh_neighbours(w, m)
-    link_tensions(w, m.par, diag)
-    wheel_contacts(w, m, diag)
-    ground_contacts(w, m, diag)
+    refresh_neighbours(apos, wc, par, seg, corners, nbr, rows, m.ref, m.counters)
+    link_tensions(apos, par, lk, fpin, diag, diag_tension(wc.shape[0]))
+    wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag)
+    ground_contacts(apos, avel, lk, fpin, par, seg, corners, nbr, rows, diag)

@@ -26,15 +26,14 @@ def wheel_offset(c, s, arms, i, la, cb, sb):
 
 
 @njit(**INLINE)
-def place(q, m, apos, wc, arm):
+def place(q, par, arms, ends, apos, wc, arm):
     """Pin and wheel-centre positions of configuration q into apos and wc; cos and sin of
     each arm's absolute angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
-    arms, ends = m.arms, m.ends
     nw = arms.shape[0]
     n_links = apos.shape[0] - 1
     c = math.cos(q[Q_PITCH])
     s = math.sin(q[Q_PITCH])
-    la = m.par[P_ARM_LENGTH]
+    la = par[P_ARM_LENGTH]
     for i in range(nw):
         beta = q[Q_PITCH] + q[Q_ARM + i]
         cb = math.cos(beta)
@@ -57,14 +56,13 @@ def place(q, m, apos, wc, arm):
 
 
 @njit(**INLINE)
-def positions(q, qd, m, w):
-    """Positions (place) and velocities of the pins and wheel centres into w."""
-    arm, arms, ends, wv, avel = w.arm, m.arms, m.ends, w.wv, w.avel
-    c, s = place(q, m, w.apos, w.wc, arm)
+def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
+    """Positions (place) and velocities of the pins and wheel centres."""
+    c, s = place(q, par, arms, ends, apos, wc, arm)
     nw = arms.shape[0]
     n_links = avel.shape[0] - 1
     om = qd[Q_PITCH]
-    la = m.par[P_ARM_LENGTH]
+    la = par[P_ARM_LENGTH]
     for i in range(nw):
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]

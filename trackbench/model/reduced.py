@@ -25,11 +25,10 @@ from .layout import (
 
 
 @njit(**INLINE)
-def _chassis_and_arms(q, qd, m, w, c, s):
+def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
     """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), every arm +
     road wheel added; the coupling B_i of each arm and its generalised force (torsion bar
     included) into w.arm. Returns (A, f, (kinetic, torsion, gravity energies))."""
-    par, arm, arms, fwheel, wv, wc, fpin, apos = m.par, w.arm, m.arms, w.fwheel, w.wv, w.wc, w.fpin, w.apos
     mc = par[P_CHASSIS_MASS]
     ma = par[P_ARM_MASS]
     ia = par[P_ARM_INERTIA]
@@ -117,12 +116,10 @@ def _chassis_acceleration(arm, d, a, f):
 
 
 @njit(**INLINE)
-def _pins(m, w, acc, ke, e_grav):
+def _pins(par, nw, apos, avel, fpin, acc, ke, e_grav):
     """Free pins: point masses under tension, contact forces and gravity."""
-    apos, avel, fpin = w.apos, w.avel, w.fpin
-    mp = m.par[P_PIN_MASS]
-    g = m.par[P_GRAVITY]
-    nw = m.arms.shape[0]
+    mp = par[P_PIN_MASS]
+    g = par[P_GRAVITY]
     for b in range(1, apos.shape[0] - 1):
         k = q_pin(nw, b)
         acc[k] = fpin[b, 0] / mp
@@ -135,25 +132,26 @@ def _pins(m, w, acc, ke, e_grav):
 @njit(**KERNEL)
 def reduced_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for y = (q, qd, W); fills diag (forces, energies, status)."""
+    par, arms = m.par, m.arms
+    apos, avel, fpin, wc, wv, fwheel, arm = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.arm
     nq = (y.shape[0] - 1) // 2
     q = y[:nq]
     qd = y[nq:2 * nq]
-    c, s = positions(q, qd, m, w)
+    c, s = positions(q, qd, par, arms, m.ends, apos, avel, wc, wv, arm)
     track_loads(w, m, diag)
-    a, f, e = _chassis_and_arms(q, qd, m, w, c, s)
-    d = m.par[P_ARM_MASS] * m.par[P_ARM_LENGTH] * m.par[P_ARM_LENGTH] + m.par[P_ARM_INERTIA]  # arm block: diagonal, constant
-    ax, ay, at = _chassis_acceleration(w.arm, d, a, f)
+    a, f, e = _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s)
+    d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal
+    ax, ay, at = _chassis_acceleration(arm, d, a, f)
     for k in range(nq):
         ydot[k] = qd[k]
     acc = ydot[nq:2 * nq]
     acc[Q_X] = ax
     acc[Q_Y] = ay
     acc[Q_PITCH] = at
-    arm = w.arm
     for i in range(arm.shape[0]):
         acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
     ke, e_tors, e_grav = e
-    ke, e_grav = _pins(m, w, acc, ke, e_grav)
+    ke, e_grav = _pins(par, arms.shape[0], apos, avel, fpin, acc, ke, e_grav)
     ydot[2 * nq] = diag[D_POWER]  # dW/dt
     diag[D_E_KINETIC] = ke
     diag[D_E_TORSION] = e_tors

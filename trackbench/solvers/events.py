@@ -138,8 +138,8 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     segment) changes are left alone. ev: EventWork scratch."""
     nq = (y0.shape[0] - 1) // 2
     n_links = ev.pins0.shape[0] - 1
-    place(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm)
-    place(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm)
+    place(y0[:nq], m.par, m.arms, m.ends, ev.pins0, ev.wheels0, ev.arm)
+    place(y1[:nq], m.par, m.arms, m.ends, ev.pins1, ev.wheels1, ev.arm)
     step = (y0, f0, y1, f1, h)
     best = 2.0
     for kind in range(N_KINDS):
