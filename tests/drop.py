@@ -29,7 +29,7 @@ def drop(damping, e=1.0, zeta=0.0, n=1.0, ramp=2e-4, k=K, m=PIN_MASS, v=V):
         delta, rate = s
         if delta <= 0.0:
             return [rate, 0.0]
-        f, _, _ = normal_force(law, code, k, n, c, chi, ramp, delta, rate, v)
+        f, _, _ = normal_force((law, code, k, n, c, chi, ramp), delta, rate, v)
         return [rate, -f / m]
 
     def leaves(t, s):

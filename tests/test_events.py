@@ -57,7 +57,7 @@ def test_event_contact_decision_equals_the_kernels(paper_run, model):
             reduced_rhs(y, m, w, np.zeros_like(y), d)
             if d[L.D_STATUS] != 0.0:
                 continue   # a wheel or corner through the track: the run would stop here
-            place(y[:nq], m, w.apos, w.wc, w.arm)
+            place(y[:nq], m.par, m.arms, m.ends, w.apos, w.wc, w.arm)
             e = _event_energy(m, w, m.par)
             assert e["wheel"] == pytest.approx(d[L.D_E_PAD_WHEEL], rel=1e-9, abs=1e-9)
             assert e["ground"] == pytest.approx(d[L.D_E_PAD_GROUND], rel=1e-9, abs=1e-9)

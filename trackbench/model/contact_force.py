@@ -17,10 +17,12 @@ def elastic(law, k, n, delta):
 
 
 @njit(**INLINE)
-def normal_force(law, damping, k, n, c, chi, ramp, delta, delta_dot, v0):
-    """(force, stored energy, dissipated power) of one contact at compression delta > 0.
-    c: viscous coefficient; chi: restitution factor (restitution_factor); ramp: d_r."""
-    f_el, energy = elastic(law, k, n, delta)
+def normal_force(law, delta, delta_dot, v0):
+    """(force, stored energy, dissipated power) of one contact at compression delta > 0
+    closing at delta_dot, v0 its approach speed at onset. law = (elastic law code, damping
+    code, k, exponent n, viscous coefficient c, restitution factor chi, ramp depth d_r)."""
+    code, damping, k, n, c, chi, ramp = law
+    f_el, energy = elastic(code, k, n, delta)
     if damping == DAMPING_NONE:
         return f_el, energy, 0.0
     if damping == DAMPING_VISCOUS:

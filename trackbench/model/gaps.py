@@ -53,12 +53,6 @@ def point_on_link(px, py, ax, ay, tx, ty):
 
 
 @njit(**INLINE)
-def link_coords(px, py, apos, lk, b):
-    """point_on_link for link b of the track (lk from link_frames)."""
-    return point_on_link(px, py, apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
-
-
-@njit(**INLINE)
 def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
     """P lies in the wedge beyond the free pin A between a link along t0 (ending at A) and
     one along t1 (starting at A) - both fail the foot test - on the convex side of the
@@ -75,19 +69,21 @@ def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
 
 
 @njit(**INLINE)
-def in_pin_wedge(px, py, apos, lk, b, towards_inner):
-    """wedge at free pin b of the track."""
-    return wedge(px, py, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1], towards_inner)
+def point_on_segment(px, py, x0, y0, tx, ty, nx, ny):
+    """(lam, s) of point P against a ground segment from (x0, y0) along t with outward
+    normal n: lam along it (the foot lies on it when 0 <= lam <= length), s along n."""
+    dx = px - x0
+    dy = py - y0
+    return dx * tx + dy * ty, dx * nx + dy * ny
 
 
 @njit(**INLINE)
 def segment_coords(px, py, seg, j):
-    """(lam, s) of point P against ground segment j: lam along it from its start (the
-    foot lies on it when 0 <= lam <= length), s along its outward normal, and dx (P's x
-    from the segment start) for the inside-the-ground test."""
-    dx = px - seg[j, SEG_X0]
-    dy = py - seg[j, SEG_Y0]
-    return dx * seg[j, SEG_TX] + dy * seg[j, SEG_TY], dx * seg[j, SEG_NX] + dy * seg[j, SEG_NY], dx
+    """point_on_segment for ground segment j, and dx (P's x from the segment start) for
+    the inside-the-ground test."""
+    lam, s = point_on_segment(px, py, seg[j, SEG_X0], seg[j, SEG_Y0], seg[j, SEG_TX], seg[j, SEG_TY],
+                              seg[j, SEG_NX], seg[j, SEG_NY])
+    return lam, s, px - seg[j, SEG_X0]
 
 
 @njit(**INLINE)
@@ -120,17 +116,12 @@ def pin_ground_selection(px, py, seg, nbr, row, hg):
 
 
 @njit(**INLINE)
-def pin_segment_valid(lam, s, seg, sj, inside, n_below, best):
-    """May segment sj push the pin (foot on it, on the right side, the nearest of several
-    it is behind)? It does when also s < h_g; h_g - s is then the pad compression."""
-    if lam < 0.0 or lam > seg[sj, SEG_LENGTH]:
+def pin_segment_valid(lam, s, length, inside, n_below, best):
+    """May a segment of this length push the pin at (lam, s) (foot on it, on the right
+    side, the nearest of several it is behind; pin_ground_selection gives inside,
+    n_below, best)? It does when also s < h_g; h_g - s is then the pad compression."""
+    if lam < 0.0 or lam > length:
         return False
     if s < 0.0 and not inside:
         return False
     return not (n_below >= 2 and s < best)
-
-
-@njit(**INLINE)
-def pin_segment_acts(lam, s, seg, sj, hg, inside, n_below, best):
-    """Does segment sj push the pin (pin_segment_valid and within the pad)?"""
-    return s < hg and pin_segment_valid(lam, s, seg, sj, inside, n_below, best)

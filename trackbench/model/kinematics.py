@@ -26,26 +26,26 @@ def wheel_offset(c, s, arms, i, la, cb, sb):
 
 
 @njit(**INLINE)
-def place(q, m, apos, wc, arm):
+def place(q, par, arms, ends, apos, wc, arm):
     """Pin and wheel-centre positions of configuration q into apos and wc; cos and sin of
     each arm's absolute angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
-    nw = m.arms.shape[0]
+    nw = arms.shape[0]
     n_links = apos.shape[0] - 1
     c = math.cos(q[Q_PITCH])
     s = math.sin(q[Q_PITCH])
-    la = m.par[P_ARM_LENGTH]
+    la = par[P_ARM_LENGTH]
     for i in range(nw):
         beta = q[Q_PITCH] + q[Q_ARM + i]
         cb = math.cos(beta)
         sb = math.sin(beta)
         arm[i, ARM_COS] = cb
         arm[i, ARM_SIN] = sb
-        rx, ry = wheel_offset(c, s, m.arms, i, la, cb, sb)
+        rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
         wc[i, 0] = q[Q_X] + rx
         wc[i, 1] = q[Q_Y] + ry
     for e in range(2):
         b = 0 if e == 0 else n_links
-        rx, ry = body_offset(c, s, m.ends[e, 0], m.ends[e, 1])
+        rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
         apos[b, 0] = q[Q_X] + rx
         apos[b, 1] = q[Q_Y] + ry
     for b in range(1, n_links):
@@ -56,26 +56,26 @@ def place(q, m, apos, wc, arm):
 
 
 @njit(**INLINE)
-def positions(q, qd, m, w):
-    """Positions (place) and velocities of the pins and wheel centres into w."""
-    c, s = place(q, m, w.apos, w.wc, w.arm)
-    nw = m.arms.shape[0]
-    n_links = w.apos.shape[0] - 1
+def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
+    """Positions (place) and velocities of the pins and wheel centres."""
+    c, s = place(q, par, arms, ends, apos, wc, arm)
+    nw = arms.shape[0]
+    n_links = avel.shape[0] - 1
     om = qd[Q_PITCH]
-    la = m.par[P_ARM_LENGTH]
+    la = par[P_ARM_LENGTH]
     for i in range(nw):
-        cb = w.arm[i, ARM_COS]
-        sb = w.arm[i, ARM_SIN]
-        rx, ry = wheel_offset(c, s, m.arms, i, la, cb, sb)
-        w.wv[i, 0] = qd[Q_X] - om * ry - qd[Q_ARM + i] * la * sb
-        w.wv[i, 1] = qd[Q_Y] + om * rx + qd[Q_ARM + i] * la * cb
+        cb = arm[i, ARM_COS]
+        sb = arm[i, ARM_SIN]
+        rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
+        wv[i, 0] = qd[Q_X] - om * ry - qd[Q_ARM + i] * la * sb
+        wv[i, 1] = qd[Q_Y] + om * rx + qd[Q_ARM + i] * la * cb
     for e in range(2):
         b = 0 if e == 0 else n_links
-        rx, ry = body_offset(c, s, m.ends[e, 0], m.ends[e, 1])
-        w.avel[b, 0] = qd[Q_X] - om * ry
-        w.avel[b, 1] = qd[Q_Y] + om * rx
+        rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
+        avel[b, 0] = qd[Q_X] - om * ry
+        avel[b, 1] = qd[Q_Y] + om * rx
     for b in range(1, n_links):
         k = q_pin(nw, b)
-        w.avel[b, 0] = qd[k]
-        w.avel[b, 1] = qd[k + 1]
+        avel[b, 0] = qd[k]
+        avel[b, 1] = qd[k + 1]
     return c, s

@@ -17,53 +17,47 @@ from .jit import INLINE, KERNEL
 from .kernels import track_loads
 from .kinematics import body_offset, positions
 from .layout import (
-    ARMS_DAMPING, ARMS_PHI0, D_DISSIPATION, Y_DISSIPATED, Y_WORK,
+    ARMS_DAMPING, ARMS_PHI0, D_DISSIPATION, Y_DISSIPATED, Y_WORK, nq_of,
     D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH,
     P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH,
     Q_X, Q_Y, q_pin,
 )
-from .layout import nq_of
 
 
 @njit(**INLINE)
-def _chassis(q, qd, m, w):
-    """The chassis alone: its mass block, the track-end pulls and gravity on it, its
-    kinetic energy and gravity potential."""
-    par, fpin, apos = m.par, w.fpin, w.apos
+def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
+    """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), every arm +
+    road wheel added; the coupling B_i of each arm and its generalised force (torsion bar
+    included) into w.arm. Returns (A, f, (kinetic, torsion, gravity energies), power
+    dissipated by the shock absorbers)."""
     mc = par[P_CHASSIS_MASS]
-    g = par[P_GRAVITY]
-    last = apos.shape[0] - 1
-    a = (mc, 0.0, 0.0, mc, 0.0, par[P_CHASSIS_INERTIA])
-    qt = 0.0
-    for b in (0, last):
-        rx = apos[b, 0] - q[Q_X]
-        ry = apos[b, 1] - q[Q_Y]
-        qt += rx * fpin[b, 1] - ry * fpin[b, 0]
-    f = (fpin[0, 0] + fpin[last, 0], fpin[0, 1] + fpin[last, 1] - mc * g, qt)
-    om = qd[Q_PITCH]
-    e = (0.5 * mc * (qd[Q_X] ** 2 + qd[Q_Y] ** 2) + 0.5 * par[P_CHASSIS_INERTIA] * om * om, 0.0, mc * g * q[Q_Y])
-    return a, f, e
-
-
-@njit(**INLINE)
-def _arms(q, qd, m, w, c, s, a, f, e):
-    """Add every arm + road wheel to the chassis block; fill the arm columns of w.arm with
-    its coupling B_i to (x, y, pitch) and its generalised force (torsion bar included)."""
-    par, arm = m.par, w.arm
     ma = par[P_ARM_MASS]
     ia = par[P_ARM_INERTIA]
     la = par[P_ARM_LENGTH]
     kt = par[P_TORSION_STIFFNESS]
     g = par[P_GRAVITY]
     om = qd[Q_PITCH]
-    a00, a01, a02, a11, a12, a22 = a
-    qx, qy, qt = f
-    ke, e_tors, e_grav = e
+    last = apos.shape[0] - 1
+    a00 = mc
+    a11 = mc
+    a22 = par[P_CHASSIS_INERTIA]
+    a01 = 0.0
+    a02 = 0.0
+    a12 = 0.0
+    qx = fpin[0, 0] + fpin[last, 0]
+    qy = fpin[0, 1] + fpin[last, 1] - mc * g
+    qt = 0.0
+    for e in range(2):
+        b = 0 if e == 0 else last
+        qt += (apos[b, 0] - q[Q_X]) * fpin[b, 1] - (apos[b, 1] - q[Q_Y]) * fpin[b, 0]
+    ke = 0.5 * mc * (qd[Q_X] ** 2 + qd[Q_Y] ** 2) + 0.5 * a22 * om * om
+    e_tors = 0.0
     dissipation = 0.0
-    for i in range(m.arms.shape[0]):
+    e_grav = mc * g * q[Q_Y]
+    for i in range(arms.shape[0]):
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
-        px, py = body_offset(c, s, m.arms[i, 0], m.arms[i, 1])
+        px, py = body_offset(c, s, arms[i, 0], arms[i, 1])
         rx = px + la * cb
         ry = py + la * sb
         rpx = -ry           # d(w)/d(pitch)
@@ -72,10 +66,8 @@ def _arms(q, qd, m, w, c, s, a, f, e):
         sy = la * cb
         wb = om + qd[Q_ARM + i]
         # velocity-dependent (centripetal) acceleration of the wheel centre
-        avx = -om * om * px - wb * wb * la * cb
-        avy = -om * om * py - wb * wb * la * sb
-        fx = w.fwheel[i, 0] - ma * avx
-        fy = w.fwheel[i, 1] - ma * g - ma * avy
+        fx = fwheel[i, 0] - ma * (-om * om * px - wb * wb * la * cb)
+        fy = fwheel[i, 1] - ma * g - ma * (-om * om * py - wb * wb * la * sb)
         a00 += ma
         a11 += ma
         a02 += ma * rpx
@@ -84,20 +76,18 @@ def _arms(q, qd, m, w, c, s, a, f, e):
         qx += fx
         qy += fy
         qt += rpx * fx + rpy * fy
-        tors = -kt * (q[Q_ARM + i] - m.arms[i, ARMS_PHI0])
         arm[i, ARM_BX] = ma * sx
         arm[i, ARM_BY] = ma * sy
         arm[i, ARM_BT] = ma * (rpx * sx + rpy * sy) + ia
-        arm[i, ARM_Q] = sx * fx + sy * fy + tors
-        cd = m.arms[i, ARMS_DAMPING]
-        if cd != 0.0:
+        arm[i, ARM_Q] = sx * fx + sy * fy - kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0])
+        if arms[i, ARMS_DAMPING] != 0.0:
             # rotary shock absorber: -c phi' on the arm, +c phi' on the chassis; phi is
             # relative to the chassis, so the pair acts on phi alone
-            arm[i, ARM_Q] -= cd * qd[Q_ARM + i]
-            dissipation += cd * qd[Q_ARM + i] ** 2
-        ke += 0.5 * ma * (w.wv[i, 0] ** 2 + w.wv[i, 1] ** 2) + 0.5 * ia * wb * wb
-        e_tors += 0.5 * kt * (q[Q_ARM + i] - m.arms[i, ARMS_PHI0]) ** 2
-        e_grav += ma * g * w.wc[i, 1]
+            arm[i, ARM_Q] -= arms[i, ARMS_DAMPING] * qd[Q_ARM + i]
+            dissipation += arms[i, ARMS_DAMPING] * qd[Q_ARM + i] ** 2
+        ke += 0.5 * ma * (wv[i, 0] ** 2 + wv[i, 1] ** 2) + 0.5 * ia * wb * wb
+        e_tors += 0.5 * kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0]) ** 2
+        e_grav += ma * g * wc[i, 1]
     return (a00, a01, a02, a11, a12, a22), (qx, qy, qt), (ke, e_tors, e_grav), dissipation
 
 
@@ -133,43 +123,42 @@ def _chassis_acceleration(arm, d, a, f):
 
 
 @njit(**INLINE)
-def _pins(m, w, acc, ke, e_grav):
+def _pins(par, nw, apos, avel, fpin, acc, ke, e_grav):
     """Free pins: point masses under tension, contact forces and gravity."""
-    mp = m.par[P_PIN_MASS]
-    g = m.par[P_GRAVITY]
-    nw = m.arms.shape[0]
-    for b in range(1, w.apos.shape[0] - 1):
+    mp = par[P_PIN_MASS]
+    g = par[P_GRAVITY]
+    for b in range(1, apos.shape[0] - 1):
         k = q_pin(nw, b)
-        acc[k] = w.fpin[b, 0] / mp
-        acc[k + 1] = w.fpin[b, 1] / mp - g
-        ke += 0.5 * mp * (w.avel[b, 0] ** 2 + w.avel[b, 1] ** 2)
-        e_grav += mp * g * w.apos[b, 1]
+        acc[k] = fpin[b, 0] / mp
+        acc[k + 1] = fpin[b, 1] / mp - g
+        ke += 0.5 * mp * (avel[b, 0] ** 2 + avel[b, 1] ** 2)
+        e_grav += mp * g * apos[b, 1]
     return ke, e_grav
 
 
 @njit(**KERNEL)
 def reduced_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for y = (q, qd, W, D); fills diag (forces, energies, status)."""
+    par, arms = m.par, m.arms
+    apos, avel, fpin, wc, wv, fwheel, arm = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.arm
     nq = nq_of(y.shape[0])
     q = y[:nq]
     qd = y[nq:2 * nq]
-    c, s = positions(q, qd, m, w)
+    c, s = positions(q, qd, par, arms, m.ends, apos, avel, wc, wv, arm)
     track_loads(w, m, diag)
-    a, f, e = _chassis(q, qd, m, w)
-    a, f, e, arm_dissipation = _arms(q, qd, m, w, c, s, a, f, e)
-    d = m.par[P_ARM_MASS] * m.par[P_ARM_LENGTH] * m.par[P_ARM_LENGTH] + m.par[P_ARM_INERTIA]  # arm block: diagonal, constant
-    ax, ay, at = _chassis_acceleration(w.arm, d, a, f)
+    a, f, e, arm_dissipation = _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s)
+    d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal
+    ax, ay, at = _chassis_acceleration(arm, d, a, f)
     for k in range(nq):
         ydot[k] = qd[k]
     acc = ydot[nq:2 * nq]
     acc[Q_X] = ax
     acc[Q_Y] = ay
     acc[Q_PITCH] = at
-    for i in range(m.arms.shape[0]):
-        acc[Q_ARM + i] = (w.arm[i, ARM_Q] - w.arm[i, ARM_BX] * ax - w.arm[i, ARM_BY] * ay
-                          - w.arm[i, ARM_BT] * at) / d
+    for i in range(arm.shape[0]):
+        acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
     ke, e_tors, e_grav = e
-    ke, e_grav = _pins(m, w, acc, ke, e_grav)
+    ke, e_grav = _pins(par, arms.shape[0], apos, avel, fpin, acc, ke, e_grav)
     diag[D_DISSIPATION] += arm_dissipation
     ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation  # dW/dt: contact forces and dampers
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]

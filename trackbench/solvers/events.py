@@ -22,7 +22,7 @@ from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, p
 from ..model.jit import INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.layout import (K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS,
-                            NB_COUNT, P_ARM_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
+                            NB_COUNT, P_ARM_LENGTH, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
                             Q_X, Q_Y, q_pin)
 from .hermite import coordinate, quintic_basis
 from ..model.layout import nq_of
@@ -80,7 +80,7 @@ def _pin_ground(px, py, sj, m, row):
     hg = m.par[P_PAD_GROUND]
     inside, n_below, best = pin_ground_selection(px, py, m.seg, m.nbr, row, hg)
     lam, s, _ = segment_coords(px, py, m.seg, sj)
-    return pin_segment_valid(lam, s, m.seg, sj, inside, n_below, best), hg - s
+    return pin_segment_valid(lam, s, m.seg[sj, SEG_LENGTH], inside, n_below, best), hg - s
 
 
 @njit(**INLINE)
@@ -139,8 +139,8 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     segment) changes are left alone. ev: EventWork scratch."""
     nq = nq_of(y0.shape[0])
     n_links = ev.pins0.shape[0] - 1
-    place(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm)
-    place(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm)
+    place(y0[:nq], m.par, m.arms, m.ends, ev.pins0, ev.wheels0, ev.arm)
+    place(y1[:nq], m.par, m.arms, m.ends, ev.pins1, ev.wheels1, ev.arm)
     step = (y0, f0, y1, f1, h)
     best = 2.0
     for kind in range(N_KINDS):

@@ -12,8 +12,8 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ..model.jit import KERNEL
-from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
+from ..model.jit import INLINE, KERNEL
+from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK, nq_of
 from ..model.kernels import remember_onsets
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL
@@ -22,7 +22,6 @@ from .control import FAC_MAX, after_acceptance, after_rejection, before_step, fi
 from .events import first_contact_switch
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
-from ..model.layout import nq_of
 
 LoopWork = namedtuple("LoopWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
@@ -41,7 +40,7 @@ def loop_arrays(stages, ny, n_diag):
                     np.empty(ny), np.empty(ny), np.empty(n_diag))
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _combine(y, h, w, K, m, out):
     """out = y + h * sum_j<m w_j K_j (zero weights skipped). K is indexed in 2D, not by
     row views: a view per stage costs reference counting (~6 % of a run)."""
@@ -55,7 +54,7 @@ def _combine(y, h, w, K, m, out):
                 out[k] += c * K[j, k]
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _error_norm(lw, tab, h, rtol, atol, n):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
@@ -108,7 +107,7 @@ def _start(y0, m, w, lw, out):
     return SUCCESSFUL, e_ref, r_ref
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _stages(h, tab, m, w, lw):
     """One step of the pair from lw.y: stages into K, the new state into y_new and its
     derivative into the last row of K (first same as last)."""
@@ -120,7 +119,7 @@ def _stages(h, tab, m, w, lw):
     reduced_rhs(lw.y_new, m, w, lw.K[s], lw.diag)
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
     """Output samples in (t, t_new] by Hermite interpolation; returns the new sample count."""
     nq = nq_of(lw.y.shape[0])
@@ -134,7 +133,7 @@ def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
     return n_out
 
 
-@njit(**KERNEL)
+@njit(**INLINE)
 def _accepted_status(lw):
     """NAN for a state that diverged, unless the evaluation found why (diag's status)."""
     status = SUCCESSFUL
