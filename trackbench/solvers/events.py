@@ -19,10 +19,11 @@ from numba import njit
 
 from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, point_on_link,
                           segment_coords, wedge)
+from ..model.contact_laws import DAMPING_VISCOUS
 from ..model.jit import INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.layout import (K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS,
-                            NB_COUNT, P_ARM_LENGTH, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
+                            NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
                             Q_X, Q_Y, q_pin)
 from .hermite import coordinate, quintic_basis
 from ..model.layout import nq_of
@@ -118,14 +119,14 @@ def _gap_end(kind, i, b, pins, wheels, m):
 
 
 @njit(**INLINE)
-def _bisect(kind, i, b, g0, step, nq, m, n_links):
-    """Upper end of the bracket of the gap's sign change (just after the kink)."""
+def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
+    """Upper end of the bracket where the gap crosses level (just after the kink)."""
     lo = 0.0
     hi = 1.0
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
         _, gm = _gap_at(kind, i, b, mid, step, nq, m, n_links)
-        if (gm > 0.0) == (g0 > 0.0):
+        if (gm > level) == (g0 > level):
             lo = mid
         else:
             hi = mid
@@ -135,13 +136,15 @@ def _bisect(kind, i, b, g0, step, nq, m, n_links):
 @njit(**KERNEL)
 def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     """Smallest t in (0, 1] at which some candidate contact starts or ends along the
-    step's interpolant; 2.0 if none. Pairs whose validity (foot on link, wedge, acting
-    segment) changes are left alone. ev: EventWork scratch."""
+    step's interpolant - or, with the viscous law, reaches the end of its dashpot's ramp,
+    a kink of the same kind; 2.0 if none. Pairs whose validity (foot on link, wedge,
+    acting segment) changes are left alone. ev: EventWork scratch."""
     nq = nq_of(y0.shape[0])
     n_links = ev.pins0.shape[0] - 1
     place(y0[:nq], m.par, m.arms, m.ends, ev.pins0, ev.wheels0, ev.arm)
     place(y1[:nq], m.par, m.arms, m.ends, ev.pins1, ev.wheels1, ev.arm)
     step = (y0, f0, y1, f1, h)
+    ramp = m.par[P_DAMPING_RAMP] if m.par[P_CONTACT_DAMPING] == DAMPING_VISCOUS else -1.0
     best = 2.0
     for kind in range(N_KINDS):
         for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
@@ -150,7 +153,10 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
                 b = m.nbr[row, 1 + j]
                 v0, g0 = _gap_end(kind, i, b, ev.pins0, ev.wheels0, m)
                 v1, g1 = _gap_end(kind, i, b, ev.pins1, ev.wheels1, m)
-                if not (v0 and v1) or (g0 > 0.0) == (g1 > 0.0):
+                if not (v0 and v1):
                     continue
-                best = min(best, _bisect(kind, i, b, g0, step, nq, m, n_links))
+                if (g0 > 0.0) != (g1 > 0.0):
+                    best = min(best, _bisect(kind, i, b, g0, 0.0, step, nq, m, n_links))
+                elif ramp > 0.0 and (g0 > ramp) != (g1 > ramp):
+                    best = min(best, _bisect(kind, i, b, g0, ramp, step, nq, m, n_links))
     return best
