@@ -55,10 +55,9 @@ def _combine(y, h, w, K, m, out):
 
 
 @njit(**INLINE)
-def _error_norm(lw, tab, h, rtol, atol, n):
+def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     """RMS norm of the embedded error estimate over the first n components
     (Hairer's DOP853 combination when e3 is given)."""
-    K, e, e3, er5, er3 = lw.K, tab.e, tab.e3, lw.er5, lw.er3
     use3 = e3[0] != 0.0
     for k in range(n):
         er5[k] = 0.0
@@ -75,7 +74,7 @@ def _error_norm(lw, tab, h, rtol, atol, n):
     s5 = 0.0
     s3 = 0.0
     for k in range(n):
-        sc = atol + rtol * max(abs(lw.y[k]), abs(lw.y_new[k]))
+        sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
         s5 += (er5[k] / sc) ** 2
         s3 += (er3[k] / sc) ** 2
     if use3:
@@ -108,90 +107,97 @@ def _start(y0, m, w, lw, out):
 
 
 @njit(**INLINE)
-def _stages(h, tab, m, w, lw):
-    """One step of the pair from lw.y: stages into K, the new state into y_new and its
+def _stages(h, A, b, m, w, y, K, ys, y_new, diag):
+    """One step of the pair from y: stages into K, the new state into y_new and its
     derivative into the last row of K (first same as last)."""
-    s = tab.b.shape[0]
+    s = b.shape[0]
     for i in range(1, s):
-        _combine(lw.y, h, tab.A[i], lw.K, i, lw.ys)
-        reduced_rhs(lw.ys, m, w, lw.K[i], lw.diag)
-    _combine(lw.y, h, tab.b, lw.K, s, lw.y_new)
-    reduced_rhs(lw.y_new, m, w, lw.K[s], lw.diag)
+        _combine(y, h, A[i], K, i, ys)
+        reduced_rhs(ys, m, w, K[i], diag)
+    _combine(y, h, b, K, s, y_new)
+    reduced_rhs(y_new, m, w, K[s], diag)
 
 
 @njit(**INLINE)
-def _samples(t, t_new, h, n_out, ctl, m, w, lw, out):
-    """Output samples in (t, t_new] by Hermite interpolation; returns the new sample count."""
-    nq = nq_of(lw.y.shape[0])
-    s = lw.K.shape[0] - 1
-    while n_out < out.y.shape[0] and n_out * ctl.dt_out <= t_new * (1.0 + 1e-12):
-        theta = min(1.0, (n_out * ctl.dt_out - t) / h)
-        hermite_second_order(lw.y, lw.K[0], lw.y_new, lw.K[s], h, theta, nq, lw.ys)
-        set_row(out.y, n_out, lw.ys)
-        reduced_rhs(lw.ys, m, w, lw.fs, out.diag[n_out])
+def _samples(t, h, n_out, dt_out, m, w, lw, out):
+    """Output samples in (t, t + h] by Hermite interpolation; returns the new sample count."""
+    y, K, y_new, ys, fs = lw.y, lw.K, lw.y_new, lw.ys, lw.fs
+    out_y, out_diag = out.y, out.diag
+    nq = nq_of(y.shape[0])
+    s = K.shape[0] - 1
+    t_new = t + h
+    while n_out < out_y.shape[0] and n_out * dt_out <= t_new * (1.0 + 1e-12):
+        theta = min(1.0, (n_out * dt_out - t) / h)
+        hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
+        set_row(out_y, n_out, ys)
+        reduced_rhs(ys, m, w, fs, out_diag[n_out])
         n_out += 1
     return n_out
 
 
 @njit(**INLINE)
-def _accepted_status(lw):
+def _accepted_status(y_new, diag):
     """NAN for a state that diverged, unless the evaluation found why (diag's status)."""
     status = SUCCESSFUL
-    for k in range(lw.y_new.shape[0]):
-        if not math.isfinite(lw.y_new[k]):
+    for k in range(y_new.shape[0]):
+        if not math.isfinite(y_new[k]):
             status = NAN
-    if lw.diag[D_STATUS] != 0.0:
-        status = int(lw.diag[D_STATUS])
+    if diag[D_STATUS] != 0.0:
+        status = int(diag[D_STATUS])
     return status
 
 
 @njit(**KERNEL)
 def integrate(y0, ctl, tab, m, w, ev, lw, out):
+    A, b, e, e3, expo = tab.A, tab.b, tab.e, tab.e3, tab.expo
+    K, y, y_new, ys, er5, er3, diag = lw.K, lw.y, lw.y_new, lw.ys, lw.er5, lw.er3, lw.diag
+    peaks = out.peaks
+    rtol, atol, h_min, h_max, t_end = ctl.rtol, ctl.atol, ctl.h_min, ctl.h_max, ctl.t_end
     ny = y0.shape[0]
     nq = nq_of(ny)
-    s = tab.b.shape[0]
+    s = b.shape[0]
     status, e_ref, r_ref = _start(y0, m, w, lw, out)
     n_rhs = 1
     n_out = 1
     t = 0.0
-    h = min(ctl.h0, ctl.h_max)
+    h = min(ctl.h0, h_max)
     steps = 0
     rejected = 0
     h_lo = np.inf
     h_hi = 0.0
     fac_max = FAC_MAX
     at_switch = False  # the step being tried ends just after a located contact switch
-    while status == SUCCESSFUL and t < ctl.t_end * (1.0 - 1e-14):
-        status, h = before_step(t, h, ctl.t_end, steps, rejected, ctl.max_steps, ctl.h_min)
+    while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
+        status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
             break
-        _stages(h, tab, m, w, lw)
+        _stages(h, A, b, m, w, y, K, ys, y_new, diag)
         n_rhs += s
-        err = _error_norm(lw, tab, h, ctl.rtol, ctl.atol, 2 * nq)  # (q, qd) only: W and D follow them
+        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, 2 * nq, er5, er3)  # (q, qd): W and D follow
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
             th = 2.0
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
-                th = first_contact_switch(lw.y, lw.K[0], lw.y_new, lw.K[s], h, m, ev)
-            h, at_switch = after_rejection(h, err, tab.expo, th, ctl.h_min)
+                th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
+            h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
         t_new = t + h
         steps += 1
         h_lo = min(h_lo, h)
         h_hi = max(h_hi, h)
-        status = _accepted_status(lw)
-        update_peaks(out.peaks, t_new, lw.diag, lw.y_new[nq + Q_X], lw.y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
+        status = _accepted_status(y_new, diag)
+        update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
-        n_new = _samples(t, t_new, h, n_out, ctl, m, w, lw, out)
+        n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
         n_rhs += n_new - n_out
         n_out = n_new
         t = t_new
         for k in range(ny):
-            lw.y[k] = lw.y_new[k]
-            lw.K[0, k] = lw.K[s, k]
-        h = after_acceptance(h, err, tab.expo, fac_max, ctl.h_max)
+            y[k] = y_new[k]
+            K[0, k] = K[s, k]
+        h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX
     finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)
