@@ -24,7 +24,8 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     nw, nl = model.nw, model.n_links
     nq = L.n_coordinates(nw, nl)
     y, d = result.y, result.diag
-    q, qd, work = y[:, :nq], y[:, nq:2 * nq], y[:, 2 * nq]
+    q, qd = y[:, :nq], y[:, nq:2 * nq]
+    work, dissipated = y[:, 2 * nq + L.Y_WORK], y[:, 2 * nq + L.Y_DISSIPATED]
     off = L.pin_offset(nw)
     n = len(result.time)
     # pins 0 and n_links ride on the chassis
@@ -76,7 +77,9 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "energy_balance": _var(T, balance, "J", "paper's energy balance: kinetic + elastic + gravity potential"),
         "energy_balance_error": _var(T, (balance - balance[0]) / e0, "1",
                                      "energy balance deviation relative to the initial total energy"),
-        "contact_work": _var(T, work, "J", "work done by all contact forces since t = 0"),
+        "contact_work": _var(T, work, "J", "work done by all contact forces and dampers since t = 0"),
+        "energy_dissipated": _var(T, dissipated, "J", "energy dissipated by all dampers since t = 0 (contact "
+                                  "damping, link dashpots, shock absorbers); 0 in the paper's model"),
         "energy_residual": _var(T, residual / e0, "1",
                                 "work-based residual: kinetic + torsion + tension + gravity - contact work, "
                                 "change since t = 0 relative to the initial total energy"),
@@ -99,9 +102,13 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     scalar("min_chassis_vx", L.PK_VX_MIN, "m s-1", "min chassis horizontal velocity")
     scalar("max_energy_balance_error", L.PK_ENERGY_BALANCE, "1", "max |energy balance deviation| / E0", 1 / e0)
     scalar("max_energy_residual", L.PK_ENERGY_RESIDUAL, "1", "max |work-based energy residual| / E0", 1 / e0)
-    first = pk[L.PK_FIRST_CORNER, 1] if pk[L.PK_FIRST_CORNER, 0] > 0 else np.nan
+    first = pk[L.PK_FIRST_OBSTACLE, 1] if pk[L.PK_FIRST_OBSTACLE, 0] > 0 else np.nan
+    corner = pk[L.PK_FIRST_CORNER, 1] if pk[L.PK_FIRST_CORNER, 0] > 0 else np.nan
     comp = pk[L.PK_FIRST_COMPRESSION, 1] if pk[L.PK_FIRST_COMPRESSION, 0] > 0 else np.nan
-    v["first_contact_time"] = _var((), first, "s", "first accepted step with a ground corner touching the track")
+    v["first_contact_time"] = _var((), first, "s", "first accepted step with the track touching an obstacle "
+                                   "(its face, corner or top: any ground feature after the first segment)")
+    v["first_corner_contact_time"] = _var((), corner, "s", "first accepted step with a ground corner touching the "
+                                          "track")
     v["first_compression_time"] = _var((), comp, "s", "first time a link goes into compression (linear between steps) "
                                        "(after it the motion is sensitive, see results_schema.md)")
     for name, arr in result.extra.items():

@@ -442,3 +442,20 @@ def remember_onsets(m, w):
                 v0[row, p] = 0.0
             elif v0[row, p] <= 0.0:
                 v0[row, p] = max(rates[row, p], v_min)
+
+
+@njit(**KERNEL)
+def onset_in_step(m, w):
+    """Did a pair come into contact in the step just tried (in contact at its end, the
+    last evaluation, with no approach speed remembered yet)? Only for the laws by
+    restitution: the solver then ends the step at the located onset, so that the
+    approach speed taken there does not depend on where the step happened to end."""
+    if m.par[P_CONTACT_DAMPING] < DAMPING_HUNT_CROSSLEY:
+        return False
+    v0, seen = m.v0, w.pair_seen
+    now = m.counters[C_EVALUATIONS]
+    for row in range(v0.shape[0]):
+        for p in range(v0.shape[1]):
+            if seen[row, p] == now and v0[row, p] <= 0.0:
+                return True
+    return False

@@ -14,7 +14,7 @@ from numba import njit
 
 from ..model.jit import INLINE, KERNEL
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK, nq_of
-from ..model.kernels import remember_onsets
+from ..model.kernels import onset_in_step, remember_onsets
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
@@ -183,6 +183,16 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
             h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
+        if onset_in_step(m, w):
+            # a contact whose law remembers its approach speed began inside the step:
+            # end the step at the onset (if located before the end) and take it there
+            th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
+            if th < 1.0 and th * h > h_min:
+                rejected += 1
+                h *= th
+                at_switch = True
+                fac_max = 1.0
+                continue
         t_new = t + h
         steps += 1
         h_lo = min(h_lo, h)
