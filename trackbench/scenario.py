@@ -23,6 +23,7 @@ GEOMETRIES = ("paper",)
 METHODS = ("dop853", "dopri5")
 TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
 OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
+PLACEMENT_KEYS = ("position", "first_contact_time", "gap")   # where an obstacle stands: one of them
 
 
 class ScenarioError(ValueError):
@@ -208,6 +209,9 @@ def _merge(base, over, prefix=""):
                 raise ScenarioError("terrain must be a table, e.g. {kind = \"step\", height = 0.1}")
             if "kind" in v and v["kind"] != base["terrain"].get("kind"):
                 base["terrain"] = {}  # a new kind starts from nothing
+            if any(p in v for p in PLACEMENT_KEYS):
+                for p in PLACEMENT_KEYS:  # the user's placement replaces the default's
+                    base["terrain"].pop(p, None)
             base["terrain"].update(copy.deepcopy(v))
         elif isinstance(base.get(k), dict):
             if not isinstance(v, dict):
