@@ -3,8 +3,8 @@
 Absolute state ``z`` (length ``nz = 3 (1 + n_wheels) + 2 (n_links - 1)``)::
 
     z[0:3]               chassis mass centre x, y and pitch theta
-    z[3 + 3 i + 0:2]     arm i: mass centre = road-wheel centre (x, y)
-    z[3 + 3 i + 2]       arm i: absolute angle beta_i of the vector pivot -> wheel centre
+    z[z_arm(i) + ZA_X, ZA_Y]   arm i: mass centre = road-wheel centre (x, y)
+    z[z_arm(i) + ZA_BETA]      arm i: absolute angle beta_i of the vector pivot -> wheel centre
     z[nb + 2 (b-1) + k]  free pin b = 1..n_links-1, coordinate k; nb = 3 (1 + n_wheels)
 
 The mass matrix is constant and diagonal (``inverse_mass``). Revolute joint i (two
@@ -27,150 +27,148 @@ import math
 import numpy as np
 from numba import njit
 
-from .jit import KERNEL
+from .jit import INLINE, KERNEL
 from .kernels import track_loads
+from .kinematics import body_offset, wheel_offset
 from .layout import (
-    D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, D_WHEEL,
-    P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY,
-    P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+    ARMS_PHI0, D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA,
+    P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS,
+    Q_ARM, Q_PITCH, Q_X, Q_Y, Y_DISSIPATED, Y_WORK, Z_PITCH, Z_X, Z_Y, ZA_BETA, ZA_X, ZA_Y, diag_tension,
+    n_absolute, nq_of, pin_offset, z_arm, z_pin,
 )
-
-
-def n_absolute(n_wheels, n_links):
-    return 3 * (1 + n_wheels) + 2 * (n_links - 1)
 
 
 def inverse_mass(par, n_wheels, n_links):
     """Diagonal of M^-1 (constant)."""
-    nb = 3 * (1 + n_wheels)
     m = np.empty(n_absolute(n_wheels, n_links))
-    m[0:2] = par[P_CHASSIS_MASS]
-    m[2] = par[P_CHASSIS_INERTIA]
+    m[[Z_X, Z_Y]] = par[P_CHASSIS_MASS]
+    m[Z_PITCH] = par[P_CHASSIS_INERTIA]
     for i in range(n_wheels):
-        m[3 + 3 * i:5 + 3 * i] = par[P_ARM_MASS]
-        m[5 + 3 * i] = par[P_ARM_INERTIA]
-    m[nb:] = par[P_PIN_MASS]
+        m[z_arm(i) + ZA_X] = m[z_arm(i) + ZA_Y] = par[P_ARM_MASS]
+        m[z_arm(i) + ZA_BETA] = par[P_ARM_INERTIA]
+    m[z_pin(n_wheels):] = par[P_PIN_MASS]
     return 1.0 / m
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def from_reduced(y, par, arms, z, zd):
-    """Reduced state (q, qd, W) -> absolute z, zd; returns W."""
+    """Reduced state (q, qd, W, D) -> absolute z, zd; returns W. The wheel centres are
+    placed as everywhere else (kinematics.wheel_offset)."""
     nw = arms.shape[0]
-    nq = (y.shape[0] - 1) // 2
-    nb = 3 * (1 + nw)
+    nq = nq_of(y.shape[0])
+    nb = z_pin(nw)
     la = par[P_ARM_LENGTH]
     th = y[Q_PITCH]
     om = y[nq + Q_PITCH]
     c = math.cos(th)
     s = math.sin(th)
-    for k in range(3):
+    for k in (Z_X, Z_Y, Z_PITCH):   # the chassis coordinates are the same in both
         z[k] = y[k]
         zd[k] = y[nq + k]
     for i in range(nw):
         beta = th + y[Q_ARM + i]
         bd = om + y[nq + Q_ARM + i]
-        rx = c * arms[i, 0] - s * arms[i, 1]
-        ry = s * arms[i, 0] + c * arms[i, 1]
         cb = math.cos(beta)
         sb = math.sin(beta)
-        j = 3 + 3 * i
-        z[j] = y[Q_X] + rx + la * cb
-        z[j + 1] = y[Q_Y] + ry + la * sb
-        z[j + 2] = beta
-        zd[j] = y[nq + Q_X] - om * ry - bd * la * sb
-        zd[j + 1] = y[nq + Q_Y] + om * rx + bd * la * cb
-        zd[j + 2] = bd
-    off = Q_ARM + nw
+        rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
+        px, py = body_offset(c, s, arms[i, 0], arms[i, 1])   # the pivot
+        j = z_arm(i)
+        z[j + ZA_X] = y[Q_X] + rx
+        z[j + ZA_Y] = y[Q_Y] + ry
+        z[j + ZA_BETA] = beta
+        zd[j + ZA_X] = y[nq + Q_X] - om * py - bd * la * sb
+        zd[j + ZA_Y] = y[nq + Q_Y] + om * px + bd * la * cb
+        zd[j + ZA_BETA] = bd
+    off = pin_offset(nw)
     for k in range(z.shape[0] - nb):
         z[nb + k] = y[off + k]
         zd[nb + k] = y[nq + off + k]
-    return y[2 * nq]
+    return y[2 * nq + Y_WORK]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def to_reduced(z, zd, work, nw, y):
-    """Absolute z, zd and contact work -> reduced (q, qd, W): phi_i = beta_i - theta."""
-    nq = (y.shape[0] - 1) // 2
-    nb = 3 * (1 + nw)
-    off = Q_ARM + nw
-    for k in range(3):
+    """Absolute z, zd and contact work -> reduced (q, qd, W, D = 0): phi_i = beta_i - theta."""
+    nq = nq_of(y.shape[0])
+    nb = z_pin(nw)
+    off = pin_offset(nw)
+    for k in (Z_X, Z_Y, Z_PITCH):
         y[k] = z[k]
         y[nq + k] = zd[k]
     for i in range(nw):
-        y[Q_ARM + i] = z[5 + 3 * i] - z[2]
-        y[nq + Q_ARM + i] = zd[5 + 3 * i] - zd[2]
+        y[Q_ARM + i] = z[z_arm(i) + ZA_BETA] - z[Z_PITCH]
+        y[nq + Q_ARM + i] = zd[z_arm(i) + ZA_BETA] - zd[Z_PITCH]
     for k in range(z.shape[0] - nb):
         y[off + k] = z[nb + k]
         y[nq + off + k] = zd[nb + k]
-    y[2 * nq] = work
+    y[2 * nq + Y_WORK] = work
+    y[2 * nq + Y_DISSIPATED] = 0.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def joint_vectors(z, par, arms, geo):
     """Per joint i: geo[i] = (r_x, r_y, l cos beta, l sin beta) with r = R(theta) p_i.
     Then dr_i = (-r_y, r_x) and d(l e_i)/d beta = (-l sin beta, l cos beta)."""
     la = par[P_ARM_LENGTH]
-    c = math.cos(z[2])
-    s = math.sin(z[2])
+    c = math.cos(z[Z_PITCH])
+    s = math.sin(z[Z_PITCH])
     for i in range(arms.shape[0]):
-        geo[i, 0] = c * arms[i, 0] - s * arms[i, 1]
-        geo[i, 1] = s * arms[i, 0] + c * arms[i, 1]
-        beta = z[5 + 3 * i]
+        geo[i, 0], geo[i, 1] = body_offset(c, s, arms[i, 0], arms[i, 1])
+        beta = z[z_arm(i) + ZA_BETA]
         geo[i, 2] = la * math.cos(beta)
         geo[i, 3] = la * math.sin(beta)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def phi(z, geo, out):
     """Position constraints Phi (Eq. 1), 2 per joint; geo from joint_vectors(z)."""
     for i in range(geo.shape[0]):
-        j = 3 + 3 * i
-        out[2 * i] = z[0] + geo[i, 0] - z[j] + geo[i, 2]
-        out[2 * i + 1] = z[1] + geo[i, 1] - z[j + 1] + geo[i, 3]
+        j = z_arm(i)
+        out[2 * i] = z[Z_X] + geo[i, 0] - z[j + ZA_X] + geo[i, 2]
+        out[2 * i + 1] = z[Z_Y] + geo[i, 1] - z[j + ZA_Y] + geo[i, 3]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def phi_q_times(geo, u, out):
     """out = Phi_q u (u: body part of a velocity or acceleration vector)."""
     for i in range(geo.shape[0]):
-        j = 3 + 3 * i
-        out[2 * i] = u[0] - geo[i, 1] * u[2] - u[j] - geo[i, 3] * u[j + 2]
-        out[2 * i + 1] = u[1] + geo[i, 0] * u[2] - u[j + 1] + geo[i, 2] * u[j + 2]
+        j = z_arm(i)
+        out[2 * i] = u[Z_X] - geo[i, 1] * u[Z_PITCH] - u[j + ZA_X] - geo[i, 3] * u[j + ZA_BETA]
+        out[2 * i + 1] = u[Z_Y] + geo[i, 0] * u[Z_PITCH] - u[j + ZA_Y] + geo[i, 2] * u[j + ZA_BETA]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def add_phi_qt(geo, lam, scale, out):
     """out += scale * Phi_q^T lambda (body components only)."""
     for i in range(geo.shape[0]):
-        j = 3 + 3 * i
+        j = z_arm(i)
         lx = scale * lam[2 * i]
         ly = scale * lam[2 * i + 1]
-        out[0] += lx
-        out[1] += ly
-        out[2] += -geo[i, 1] * lx + geo[i, 0] * ly
-        out[j] -= lx
-        out[j + 1] -= ly
-        out[j + 2] += -geo[i, 3] * lx + geo[i, 2] * ly
+        out[Z_X] += lx
+        out[Z_Y] += ly
+        out[Z_PITCH] += -geo[i, 1] * lx + geo[i, 0] * ly
+        out[j + ZA_X] -= lx
+        out[j + ZA_Y] -= ly
+        out[j + ZA_BETA] += -geo[i, 3] * lx + geo[i, 2] * ly
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def gamma(zd, geo, out):
     """Right side of the acceleration constraint: Phi_q zdd = gamma = theta'^2 r_i + beta_i'^2 l e_i,
     so the error of Eq. (14) is v = gamma - Phi_q zdd."""
-    w2 = zd[2] * zd[2]
+    w2 = zd[Z_PITCH] * zd[Z_PITCH]
     for i in range(geo.shape[0]):
-        b2 = zd[5 + 3 * i] ** 2
+        b2 = zd[z_arm(i) + ZA_BETA] ** 2
         out[2 * i] = w2 * geo[i, 0] + b2 * geo[i, 2]
         out[2 * i + 1] = w2 * geo[i, 1] + b2 * geo[i, 3]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def constraint_matrix(geo, minv, G):
     """G = Phi_q M^-1 Phi_q^T (the paper's C up to the factors of Eqs. 17-19)."""
     nw = geo.shape[0]
-    mc = minv[0]
-    ic = minv[2]
+    mc = minv[Z_X]
+    ic = minv[Z_PITCH]
     for i in range(nw):
         ai = (-geo[i, 1], geo[i, 0])
         for j in range(nw):
@@ -181,70 +179,47 @@ def constraint_matrix(geo, minv, G):
                     if r == k:
                         v += mc
                     G[2 * i + r, 2 * j + k] = v
-        ma = minv[3 + 3 * i]
-        ia = minv[5 + 3 * i]
+        ma = minv[z_arm(i) + ZA_X]
+        ia = minv[z_arm(i) + ZA_BETA]
         si = (-geo[i, 3], geo[i, 2])
         for r in range(2):
             for k in range(2):
                 G[2 * i + r, 2 * i + k] += ia * si[r] * si[k] + (ma if r == k else 0.0)
 
 
-@njit(**KERNEL)
-def applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, F, fc, diag):
-    """F = applied generalised forces (no lambda) at z; fc = contact-only force on every
-    pin (tension removed), fwheel (in work) = contact force on each wheel; diag filled by
-    track_loads (forces, pad and tension energies, status). zd only feeds track_loads'
-    power, which the solver recomputes (contact_power) with its final velocities."""
-    apos, avel, fpin, fwheel, wc, wv, lk, arm = work
-    nw = arms.shape[0]
+@njit(**INLINE)
+def _place_absolute(z, zd, ends, w):
+    """Pin and wheel-centre positions and velocities from the absolute state into w."""
+    apos, avel, wc, wv = w.apos, w.avel, w.wc, w.wv
     n_pins = apos.shape[0]
-    nb = 3 * (1 + nw)
-    c = math.cos(z[2])
-    s = math.sin(z[2])
-    for i in range(nw):
-        j = 3 + 3 * i
-        wc[i, 0] = z[j]
-        wc[i, 1] = z[j + 1]
-        wv[i, 0] = zd[j]
-        wv[i, 1] = zd[j + 1]
+    nb = z_pin(wc.shape[0])
+    c = math.cos(z[Z_PITCH])
+    s = math.sin(z[Z_PITCH])
+    for i in range(wc.shape[0]):
+        j = z_arm(i)
+        wc[i, 0] = z[j + ZA_X]
+        wc[i, 1] = z[j + ZA_Y]
+        wv[i, 0] = zd[j + ZA_X]
+        wv[i, 1] = zd[j + ZA_Y]
     for e in range(2):
         b = 0 if e == 0 else n_pins - 1
-        rx = c * ends[e, 0] - s * ends[e, 1]
-        ry = s * ends[e, 0] + c * ends[e, 1]
-        apos[b, 0] = z[0] + rx
-        apos[b, 1] = z[1] + ry
-        avel[b, 0] = zd[0] - zd[2] * ry
-        avel[b, 1] = zd[1] + zd[2] * rx
+        rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
+        apos[b, 0] = z[Z_X] + rx
+        apos[b, 1] = z[Z_Y] + ry
+        avel[b, 0] = zd[Z_X] - zd[Z_PITCH] * ry
+        avel[b, 1] = zd[Z_Y] + zd[Z_PITCH] * rx
     for b in range(1, n_pins - 1):
         k = nb + 2 * (b - 1)
         apos[b, 0] = z[k]
         apos[b, 1] = z[k + 1]
         avel[b, 0] = zd[k]
         avel[b, 1] = zd[k + 1]
-    t_off = D_WHEEL + 2 * nw
-    track_loads(apos, avel, wc, wv, par, seg, corners, nbr, ref, lk, fpin, fwheel, diag, t_off)
-    g = par[P_GRAVITY]
-    kt = par[P_TORSION_STIFFNESS]
-    F[0] = fpin[0, 0] + fpin[n_pins - 1, 0]
-    F[1] = fpin[0, 1] + fpin[n_pins - 1, 1] - par[P_CHASSIS_MASS] * g
-    tq = 0.0
-    for e in range(2):
-        b = 0 if e == 0 else n_pins - 1
-        tq += (apos[b, 0] - z[0]) * fpin[b, 1] - (apos[b, 1] - z[1]) * fpin[b, 0]
-    for i in range(nw):
-        j = 3 + 3 * i
-        tors = -kt * (z[j + 2] - z[2] - arms[i, 2])
-        tq -= tors
-        F[j] = fwheel[i, 0]
-        F[j + 1] = fwheel[i, 1] - par[P_ARM_MASS] * g
-        F[j + 2] = tors
-    F[2] = tq
-    mg = par[P_PIN_MASS] * g
-    for b in range(1, n_pins - 1):
-        k = nb + 2 * (b - 1)
-        F[k] = fpin[b, 0]
-        F[k + 1] = fpin[b, 1] - mg
-    # contact-only pin forces: remove the link pulls of Eq. (8)
+
+
+@njit(**INLINE)
+def _contact_only(fpin, lk, diag, t_off, fc):
+    """fc = the pin forces without the link pulls of Eq. (8)."""
+    n_pins = fpin.shape[0]
     for b in range(n_pins):
         fc[b, 0] = fpin[b, 0]
         fc[b, 1] = fpin[b, 1]
@@ -256,44 +231,82 @@ def applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, F, fc, 
         fc[b + 1, 1] += tn * lk[b, 1]
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
+def applied_forces(z, zd, m, w, F, fc, diag):
+    """F = applied generalised forces (no lambda) at z; fc = contact-only force on every
+    pin (tension removed), w.fwheel = contact force on each wheel; diag filled by
+    track_loads (forces, pad and tension energies, status). zd only feeds track_loads'
+    power, which the solver recomputes (contact_power) with its final velocities."""
+    par, arms = m.par, m.arms
+    apos, fpin, fwheel = w.apos, w.fpin, w.fwheel
+    nw = arms.shape[0]
+    n_pins = apos.shape[0]
+    nb = z_pin(nw)
+    _place_absolute(z, zd, m.ends, w)
+    track_loads(w, m, diag)
+    g = par[P_GRAVITY]
+    kt = par[P_TORSION_STIFFNESS]
+    F[Z_X] = fpin[0, 0] + fpin[n_pins - 1, 0]
+    F[Z_Y] = fpin[0, 1] + fpin[n_pins - 1, 1] - par[P_CHASSIS_MASS] * g
+    tq = 0.0
+    for e in range(2):
+        b = 0 if e == 0 else n_pins - 1
+        tq += (apos[b, 0] - z[Z_X]) * fpin[b, 1] - (apos[b, 1] - z[Z_Y]) * fpin[b, 0]
+    for i in range(nw):
+        j = z_arm(i)
+        tors = -kt * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0])
+        tq -= tors
+        F[j + ZA_X] = fwheel[i, 0]
+        F[j + ZA_Y] = fwheel[i, 1] - par[P_ARM_MASS] * g
+        F[j + ZA_BETA] = tors
+    F[Z_PITCH] = tq
+    mg = par[P_PIN_MASS] * g
+    for b in range(1, n_pins - 1):
+        k = nb + 2 * (b - 1)
+        F[k] = fpin[b, 0]
+        F[k + 1] = fpin[b, 1] - mg
+    _contact_only(fpin, w.lk, diag, diag_tension(nw), fc)
+
+
+@njit(**KERNEL)
 def contact_power(z, zd, ends, fc, fw, nw):
     """Power of the contact forces fc (on pins), fw (on wheels) at velocity zd; the same
     sum track_loads forms for D_POWER (pins 0 and n_links move with the chassis)."""
     n_pins = fc.shape[0]
-    nb = 3 * (1 + nw)
-    c = math.cos(z[2])
-    s = math.sin(z[2])
+    nb = z_pin(nw)
+    c = math.cos(z[Z_PITCH])
+    s = math.sin(z[Z_PITCH])
     p = 0.0
     for e in range(2):
         b = 0 if e == 0 else n_pins - 1
-        rx = c * ends[e, 0] - s * ends[e, 1]
-        ry = s * ends[e, 0] + c * ends[e, 1]
-        p += fc[b, 0] * (zd[0] - zd[2] * ry) + fc[b, 1] * (zd[1] + zd[2] * rx)
+        rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
+        p += fc[b, 0] * (zd[Z_X] - zd[Z_PITCH] * ry) + fc[b, 1] * (zd[Z_Y] + zd[Z_PITCH] * rx)
     for b in range(1, n_pins - 1):
         k = nb + 2 * (b - 1)
         p += fc[b, 0] * zd[k] + fc[b, 1] * zd[k + 1]
     for i in range(nw):
-        p += fw[i, 0] * zd[3 + 3 * i] + fw[i, 1] * zd[4 + 3 * i]
+        p += fw[i, 0] * zd[z_arm(i) + ZA_X] + fw[i, 1] * zd[z_arm(i) + ZA_Y]
     return p
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def finish_diag(z, zd, zdd, par, arms, power, diag):
     """Fill what reduced_rhs fills beyond track_loads: kinetic, torsion and gravity
     energy, contact power and chassis acceleration."""
     nw = arms.shape[0]
-    nb = 3 * (1 + nw)
+    nb = z_pin(nw)
     g = par[P_GRAVITY]
     kt = par[P_TORSION_STIFFNESS]
-    ke = 0.5 * par[P_CHASSIS_MASS] * (zd[0] ** 2 + zd[1] ** 2) + 0.5 * par[P_CHASSIS_INERTIA] * zd[2] ** 2
-    eg = par[P_CHASSIS_MASS] * g * z[1]
+    ke = (0.5 * par[P_CHASSIS_MASS] * (zd[Z_X] ** 2 + zd[Z_Y] ** 2)
+          + 0.5 * par[P_CHASSIS_INERTIA] * zd[Z_PITCH] ** 2)
+    eg = par[P_CHASSIS_MASS] * g * z[Z_Y]
     et = 0.0
     for i in range(nw):
-        j = 3 + 3 * i
-        ke += 0.5 * par[P_ARM_MASS] * (zd[j] ** 2 + zd[j + 1] ** 2) + 0.5 * par[P_ARM_INERTIA] * zd[j + 2] ** 2
-        eg += par[P_ARM_MASS] * g * z[j + 1]
-        et += 0.5 * kt * (z[j + 2] - z[2] - arms[i, 2]) ** 2
+        j = z_arm(i)
+        ke += (0.5 * par[P_ARM_MASS] * (zd[j + ZA_X] ** 2 + zd[j + ZA_Y] ** 2)
+               + 0.5 * par[P_ARM_INERTIA] * zd[j + ZA_BETA] ** 2)
+        eg += par[P_ARM_MASS] * g * z[j + ZA_Y]
+        et += 0.5 * kt * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0]) ** 2
     mp = par[P_PIN_MASS]
     for k in range(nb, z.shape[0], 2):
         ke += 0.5 * mp * (zd[k] ** 2 + zd[k + 1] ** 2)
@@ -302,5 +315,5 @@ def finish_diag(z, zd, zdd, par, arms, power, diag):
     diag[D_E_TORSION] = et
     diag[D_E_GRAVITY] = eg
     diag[D_POWER] = power
-    diag[D_CHASSIS_AX] = zdd[0]
-    diag[D_CHASSIS_AY] = zdd[1]
+    diag[D_CHASSIS_AX] = zdd[Z_X]
+    diag[D_CHASSIS_AY] = zdd[Z_Y]

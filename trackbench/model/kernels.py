@@ -17,7 +17,7 @@ from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 from .gaps import (link_frames, pin_ground_selection, pin_segment_valid, point_on_link, point_on_segment,
                    segment_coords, wedge)
 from .contact_force import normal_force
-from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE
+from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, LAW_LINEAR
 from .jit import INLINE, KERNEL
 from .layout import (
     C_EVALUATIONS, D_DISSIPATION, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW,
@@ -201,27 +201,33 @@ def _link_rate(vx, vy, avel, lk, b, d0):
     return (vx - avel[b, 0]) * lk[b, 1] - (vy - avel[b, 1]) * lk[b, 0] + d0 * omega
 
 
-@njit(**INLINE)
-def _approach_speed(mem, row, partner, rate, v_min):
-    """v0 of a pair in contact: the speed remembered at its onset (remember_onsets), or,
-    for an onset inside the step being tried, the current rate, which becomes the memory
-    once the step is accepted. mem = (v0 table, seen stamps, rates, counters); the stamps
-    and rates are written only for the laws by restitution."""
-    v0tab, seen, rates, counters = mem
-    seen[row, partner] = counters[C_EVALUATIONS]
-    rates[row, partner] = rate
-    v0 = v0tab[row, partner]
-    return v0 if v0 > 0.0 else max(rate, v_min)
+@njit(**KERNEL)
+def law_force(law, delta, rate, mem, row, partner):
+    """normal_force of one contact by a law beyond the paper's (compiled once, called:
+    the paper's linear spring stays inline in the loops). For the laws by restitution
+    the approach speed v0 is the one remembered at the pair's onset (remember_onsets),
+    or, for an onset inside the step being tried, the current rate, which becomes the
+    memory once the step is accepted. mem = (v0 table, seen stamps, rates, counters,
+    min approach speed)."""
+    v0 = 1.0
+    if law[1] >= DAMPING_HUNT_CROSSLEY:
+        v0tab, seen, rates, counters, v_min = mem
+        seen[row, partner] = counters[C_EVALUATIONS]
+        rates[row, partner] = rate
+        v0 = v0tab[row, partner]
+        if v0 <= 0.0:
+            v0 = max(rate, v_min)
+    return normal_force(law, delta, rate, v0)
 
 
 @njit(**INLINE)
 def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, mem):
     """Every road wheel against the track: links (Fig. 3, Eq. 4), then free pins in the
-    wedge (Fig. 4). mem: see _approach_speed."""
+    wedge (Fig. 4). mem: see law_force."""
     law = contact_law(par, P_C_WHEEL)
+    k = law[2]
     damped = law[1] != DAMPING_NONE
-    memory = law[1] >= DAMPING_HUNT_CROSSLEY
-    v_min = par[P_MIN_APPROACH]
+    plain = law[0] == LAW_LINEAR and not damped    # the paper's spring: no call
     rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
     r0 = rows[K_WHEEL_LINK]
     r1 = rows[K_WHEEL_PIN]
@@ -242,9 +248,11 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
             if s < 0.0:
                 diag[D_STATUS] = WHEEL_THROUGH_TRACK
                 continue
-            rate = -_link_rate(wv[i, 0], wv[i, 1], avel, lk, b, d0) if damped else 0.0
-            v0 = _approach_speed(mem, row, b, rate, v_min) if memory else 1.0
-            p, e, pd = normal_force(law, rho - s, rate, v0)  # Eq. (4)
+            if plain:
+                p, e, pd = k * (rho - s), 0.5 * k * (rho - s) ** 2, 0.0  # Eq. (4)
+            else:
+                rate = -_link_rate(wv[i, 0], wv[i, 1], avel, lk, b, d0) if damped else 0.0
+                p, e, pd = law_force(law, rho - s, rate, mem, row, b)
             fx = p * lk[b, 1]
             fy = -p * lk[b, 0]
             fwx += fx
@@ -264,9 +272,11 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
             dist = math.sqrt(dx * dx + dy * dy)
             if dist >= rho:
                 continue
-            rate = -(dx * (wv[i, 0] - avel[b, 0]) + dy * (wv[i, 1] - avel[b, 1])) / dist if damped else 0.0
-            v0 = _approach_speed(mem, row, b, rate, v_min) if memory else 1.0
-            p, e, pd = normal_force(law, rho - dist, rate, v0)
+            if plain:
+                p, e, pd = k * (rho - dist), 0.5 * k * (rho - dist) ** 2, 0.0
+            else:
+                rate = -(dx * (wv[i, 0] - avel[b, 0]) + dy * (wv[i, 1] - avel[b, 1])) / dist if damped else 0.0
+                p, e, pd = law_force(law, rho - dist, rate, mem, row, b)
             fx = p * dx / dist
             fy = p * dy / dist
             fwx += fx
@@ -293,9 +303,9 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
     loop. Every segment after the first (the ground the vehicle starts on) belongs to an
     obstacle."""
     law = contact_law(par, P_C_GROUND)
+    k = law[2]
     damped = law[1] != DAMPING_NONE
-    memory = law[1] >= DAMPING_HUNT_CROSSLEY
-    v_min = par[P_MIN_APPROACH]
+    plain = law[0] == LAW_LINEAR and not damped
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
@@ -310,9 +320,11 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
                                       seg[sj, SEG_TY], seg[sj, SEG_NX], seg[sj, SEG_NY])
             if s >= hg or not pin_segment_valid(lam, s, seg[sj, SEG_LENGTH], inside, n_below, best):
                 continue
-            rate = -(avel[b, 0] * seg[sj, SEG_NX] + avel[b, 1] * seg[sj, SEG_NY]) if damped else 0.0
-            v0 = _approach_speed(mem, row, sj, rate, v_min) if memory else 1.0
-            p, e, pd = normal_force(law, hg - s, rate, v0)  # Eq. (6)
+            if plain:
+                p, e, pd = k * (hg - s), 0.5 * k * (hg - s) ** 2, 0.0  # Eq. (6)
+            else:
+                rate = -(avel[b, 0] * seg[sj, SEG_NX] + avel[b, 1] * seg[sj, SEG_NY]) if damped else 0.0
+                p, e, pd = law_force(law, hg - s, rate, mem, row, sj)
             fx = p * seg[sj, SEG_NX]
             fy = p * seg[sj, SEG_NY]
             fpin[b, 0] += fx
@@ -332,9 +344,9 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
     """Every ground corner against the links (Fig. 5 right, split by Eq. 7) and against
     free pins in the wedge (Fig. 6); acc as in _pins_on_ground."""
     law = contact_law(par, P_C_GROUND)
+    k = law[2]
     damped = law[1] != DAMPING_NONE
-    memory = law[1] >= DAMPING_HUNT_CROSSLEY
-    v_min = par[P_MIN_APPROACH]
+    plain = law[0] == LAW_LINEAR and not damped
     hg = par[P_PAD_GROUND]
     r_link = rows[K_CORNER_LINK]
     r_pin = rows[K_CORNER_PIN]
@@ -352,9 +364,11 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
             if s < 0.0:
                 diag[D_STATUS] = CORNER_THROUGH_TRACK
                 continue
-            rate = _link_rate(0.0, 0.0, avel, lk, b, d0) if damped else 0.0   # -ds/dt: s = -s_in
-            v0 = _approach_speed(mem, r_link + c, b, rate, v_min) if memory else 1.0
-            p, e, pd = normal_force(law, hg - s, rate, v0)
+            if plain:
+                p, e, pd = k * (hg - s), 0.5 * k * (hg - s) ** 2, 0.0
+            else:
+                rate = _link_rate(0.0, 0.0, avel, lk, b, d0) if damped else 0.0   # -ds/dt: s = -s_in
+                p, e, pd = law_force(law, hg - s, rate, mem, r_link + c, b)
             fx = p * lk[b, 1]
             fy = -p * lk[b, 0]
             gx += fx
@@ -373,9 +387,11 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
             dist = math.sqrt(dx * dx + dy * dy)
             if dist >= hg:
                 continue
-            rate = (dx * avel[b, 0] + dy * avel[b, 1]) / dist if damped else 0.0
-            v0 = _approach_speed(mem, r_pin + c, b, rate, v_min) if memory else 1.0
-            p, e, pd = normal_force(law, hg - dist, rate, v0)
+            if plain:
+                p, e, pd = k * (hg - dist), 0.5 * k * (hg - dist) ** 2, 0.0
+            else:
+                rate = (dx * avel[b, 0] + dy * avel[b, 1]) / dist if damped else 0.0
+                p, e, pd = law_force(law, hg - dist, rate, mem, r_pin + c, b)
             fx = -p * dx / dist
             fy = -p * dy / dist
             fpin[b, 0] += fx
@@ -413,7 +429,7 @@ def track_loads(w, m, diag):
     status in diag. Gravity is left to the caller."""
     apos, avel, fpin, wc, wv, fwheel, lk = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.lk
     par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
-    mem = (m.v0, w.pair_seen, w.pair_rate, m.counters)
+    mem = (m.v0, w.pair_seen, w.pair_rate, m.counters, par[P_MIN_APPROACH])
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
     diag[D_DISSIPATION] = 0.0

@@ -118,7 +118,7 @@ def _gap_end(kind, i, b, pins, wheels, m):
                  _reach(kind, m.par))
 
 
-@njit(**INLINE)
+@njit(**KERNEL)
 def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
     """Upper end of the bracket where the gap crosses level (just after the kink)."""
     lo = 0.0
@@ -151,12 +151,18 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, NB_COUNT]):
                 b = m.nbr[row, 1 + j]
-                v0, g0 = _gap_end(kind, i, b, ev.pins0, ev.wheels0, m)
-                v1, g1 = _gap_end(kind, i, b, ev.pins1, ev.wheels1, m)
-                if not (v0 and v1):
-                    continue
-                if (g0 > 0.0) != (g1 > 0.0):
-                    best = min(best, _bisect(kind, i, b, g0, 0.0, step, nq, m, n_links))
-                elif ramp > 0.0 and (g0 > ramp) != (g1 > ramp):
-                    best = min(best, _bisect(kind, i, b, g0, ramp, step, nq, m, n_links))
+                valid = True
+                g0 = 0.0
+                g1 = 0.0
+                for e in range(2):   # one inlined copy of _gap_end for both ends
+                    v, g = _gap_end(kind, i, b, ev.pins0 if e == 0 else ev.pins1,
+                                    ev.wheels0 if e == 0 else ev.wheels1, m)
+                    valid = valid and v
+                    if e == 0:
+                        g0 = g
+                    else:
+                        g1 = g
+                level = 0.0 if (g0 > 0.0) != (g1 > 0.0) else ramp
+                if valid and level >= 0.0 and (g0 > level) != (g1 > level):
+                    best = min(best, _bisect(kind, i, b, g0, level, step, nq, m, n_links))
     return best

@@ -5,18 +5,17 @@ solver-specific figures go to RunResult.extra (results_schema.md, lee section)."
 
 import numpy as np
 
+from ..model import layout as L
 from ..model.absolute import inverse_mass
-from ..model.layout import S_N_OUT
+from ..model.bundles import event_arrays
 from ..output import _var
-from .base import allocate_outputs, trimmed
-from .lee_loop import (L_BUILDS, L_DIAG_UNCONVERGED, L_EPS1, L_IT_ACC, L_IT_DIAG, L_IT_OUT, L_IT_POS,
-                       L_IT_VEL, L_PASSES, L_RATIO_ACC, L_RATIO_POS, L_RATIO_VEL, L_REJ_CONSTRAINT,
-                       L_REJ_ERROR, N_L, N_X, X_ERR_ACC, X_ERR_POS, X_ERR_VEL, X_H, X_IT_ACC, X_IT_POS,
-                       X_IT_VEL, X_RATIO_ACC, X_RATIO_POS, X_RATIO_VEL, X_REJECTED, X_STEPS, integrate_lee)
+from .base import allocate_outputs, control, trimmed
+from .lee_loop import integrate_lee
+from .lee_work import (L_BUILDS, L_DIAG_UNCONVERGED, L_EPS1, L_IT_ACC, L_IT_DIAG, L_IT_OUT, L_IT_POS, L_IT_VEL,
+                       L_PASSES, L_RATIO_ACC, L_RATIO_POS, L_RATIO_VEL, L_REJ_CONSTRAINT, L_REJ_ERROR, X_ERR_ACC,
+                       X_ERR_POS, X_ERR_VEL, X_H, X_IT_ACC, X_IT_POS, X_IT_VEL, X_RATIO_ACC, X_RATIO_POS,
+                       X_RATIO_VEL, X_REJECTED, X_STEPS, LeeSettings, lee_arrays, lee_outputs)
 from .rkn_tableau import RKN64
-
-H0 = 1e-5        # s: first trial step
-H_MIN = 1e-13    # s: below this the run stops with STEP_SIZE_UNDERFLOW
 
 _PER_SAMPLE = [  # (name, column, units, long_name)
     ("lee_steps", X_STEPS, "1", "accepted steps since the previous output sample"),
@@ -38,22 +37,18 @@ _PER_SAMPLE = [  # (name, column, units, long_name)
 
 
 def run(scenario, model, y0):
-    A, b, bp, c, eb, ebp, expo = RKN64.arrays()
-    out_y, out_d, peaks, stats = allocate_outputs(scenario, model, y0.size)
-    n_out = out_y.shape[0]
-    out_x = np.zeros((n_out, N_X))
-    out_lam = np.full((n_out, 2 * model.nw), np.nan)
-    lstats = np.zeros(N_L)
-    tol = scenario["tolerance"]
-    dt_out = scenario["output_interval"]
+    tab = RKN64.arrays()
+    out = allocate_outputs(scenario, model, y0.size)
+    lout = lee_outputs(out.y.shape[0], model.nw)
+    ls = LeeSettings(int(scenario["lee.accel_order"]), int(scenario["lee.eps_iterations"]),
+                     float(scenario["lee.position_tol"]), int(scenario["lee.max_iterations"]),
+                     float(scenario["lee.matrix_update_angle"]))
+    lw = lee_arrays(model.nw, model.n_links, tab.c.shape[0], L.n_diag(model.nw, model.n_links), y0.size)
     minv = inverse_mass(model.par, model.nw, model.n_links)
-    integrate_lee(y0, scenario["duration"], dt_out, A, b, bp, c, eb, ebp, expo, tol, tol,
-                  min(H0, dt_out), dt_out, H_MIN, scenario["max_steps"],
-                  scenario["lee.accel_order"], scenario["lee.eps_iterations"], scenario["lee.position_tol"],
-                  scenario["lee.max_iterations"], scenario["lee.matrix_update_angle"], minv,
-                  model.par, model.arms, model.ends, model.seg, model.corners, model.nbr, model.ref,
-                  model.work, out_y, out_d, out_x, out_lam, peaks, stats, lstats)
-    n = int(stats[S_N_OUT])
+    integrate_lee(y0, control(scenario), tab, ls, minv, model.arrays, model.work,
+                  event_arrays(model.nw, model.n_links), lw, out, lout)
+    n = int(out.stats[L.S_N_OUT])
+    out_x, out_lam, lstats = lout
     T, W = ("time",), ("time", "wheel")
     extra = {name: _var(T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
     extra["joint_force_x"] = _var(W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
@@ -85,4 +80,4 @@ def run(scenario, model, y0):
     for name, k, units, text in totals:
         extra[name] = _var((), lstats[k], units, text)
     extra["lee_accel_order"] = _var((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
-    return trimmed(scenario, out_y, out_d, peaks, stats, extra)
+    return trimmed(scenario, out, extra)

@@ -22,9 +22,11 @@ import math
 from numba import njit
 
 from ..model.absolute import add_phi_qt, gamma, phi_q_times
+from ..model.jit import KERNEL
+from ..model.layout import z_pin
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def inf_norm(G):
     g = 0.0
     for i in range(G.shape[0]):
@@ -35,7 +37,7 @@ def inf_norm(G):
     return g
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     """Fill An (= A_n / w_n) for C_1 = G / ||G||_inf; returns (alpha_n, ||G||_inf)."""
     m = G.shape[0]
@@ -73,7 +75,7 @@ def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     return 2.0 / (1.0 + eps), gn
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def update(lam, An, v, scale):
     """Eq. (15): lam -= scale * A_n v (scale = alpha / ||C||_inf)."""
     m = lam.shape[0]
@@ -84,7 +86,7 @@ def update(lam, An, v, scale):
         lam[i] -= scale * acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def max_abs(v):
     e = 0.0
     for i in range(v.shape[0]):
@@ -92,7 +94,7 @@ def max_abs(v):
     return e
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def norm2(v):
     s = 0.0
     for i in range(v.shape[0]):
@@ -100,7 +102,7 @@ def norm2(v):
     return math.sqrt(s)
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
     """zdd (body part) = M^-1 (F - Phi_q^T lam); v = Eq. (14) error = gamma - Phi_q zdd."""
     for k in range(nbody):
@@ -113,10 +115,14 @@ def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
         v[i] = gam[i] - v[i]
 
 
-@njit(cache=True, error_model="numpy")
-def acceleration_level(F, geo, zd, minv, lam, An, alpha, gn, tol, max_it, nbody, zdd, gam, v):
+@njit(**KERNEL)
+def acceleration_level(F, geo, zd, minv, lam, itm, tol, max_it, scratch):
     """Step 4: iterate lam with the acceleration error Eq. (14) (C = G, Eq. 19).
-    Returns (iterations, final max |v|); iterations = -1 if not converged."""
+    itm = (A_n, alpha, ||G||_inf); scratch = (zdd, gamma, v): zdd holds the body part of
+    the acceleration on return. Returns (iterations, final max |v|); -1 if not converged."""
+    An, alpha, gn = itm
+    zdd, gam, v = scratch
+    nbody = z_pin(geo.shape[0])
     gamma(zd, geo, gam)
     for it in range(max_it + 1):
         accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v)
@@ -129,7 +135,7 @@ def acceleration_level(F, geo, zd, minv, lam, An, alpha, gn, tol, max_it, nbody,
     return -1, err
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     """Eq. (20): n_iter plain iterations (n = 1, alpha = 1.9) at the acceleration level;
     returns eps-bar-1 (clipped to (0, 1])."""
@@ -149,13 +155,16 @@ def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     return min(1.0, max(est, 1e-6))
 
 
-@njit(cache=True, error_model="numpy")
-def velocity_level(zd, geo_end, geos, bp, c, h, minv, lam, An, alpha, gn, tol, max_it, nbody, dl, u, v):
+@njit(**KERNEL)
+def velocity_level(zd, geo_end, geos, bp, c, h, minv, lam, itm, tol, max_it, scratch):
     """Step 3: with the stage forces of step 1 held, the body velocity at t + h depends on
     the end value lam of the multipliers (linear over the step) through
     zd = zd_1 - h sum_j bp_j c_j M^-1 Phi_q(Z_j)^T (lam - lam_1). Iterate lam with the
     velocity error Eq. (13) (C = h/2 G, Eq. 18); zd is updated in place.
-    Returns (iterations, final max |v|)."""
+    itm = (A_n, alpha, ||G||_inf); scratch = (dl, u, v). Returns (iterations, final max |v|)."""
+    An, alpha, gn = itm
+    dl, u, v = scratch
+    nbody = z_pin(geo_end.shape[0])
     ns = bp.shape[0]
     m = lam.shape[0]
     scale = alpha / (0.5 * h * gn)

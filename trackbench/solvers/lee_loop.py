@@ -24,6 +24,11 @@ Output samples: quintic Hermite interpolation of (z, zd) (cubic for the contact 
 then forces and the acceleration level at the sample, so diag means what reduced_rhs
 puts there. The chassis acceleration in diag (samples and peaks) and the joint forces come
 from a copy of the multipliers iterated on to DIAG_ACC_TOL (below).
+
+Every array the loop uses is allocated by the Python side (lee.py) and arrives bundled:
+``lw`` (LeeWork, lee_work.py), ``lout`` (LeeOutputs), ``ls`` (LeeSettings), the rest as in
+the reduced solver (solvers/reduced.py). Scalars that live from step to step sit in
+``lw.sc`` under the SC_* names.
 """
 
 import math
@@ -33,15 +38,20 @@ from numba import njit
 
 from ..model.absolute import (applied_forces, constraint_matrix, contact_power, finish_diag, from_reduced,
                               joint_vectors, phi, to_reduced)
-from ..model.layout import (D_E_GRAVITY, D_STATUS, S_E0, S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS,
-                            S_STATUS, S_STEPS, S_T_FINAL)
+from ..model.jit import KERNEL
+from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, Z_PITCH, ZA_BETA, Z_X, z_arm, z_pin
 from ..status import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
 from .arrays import copy_2d, copy_into, set_row
-from .control import FAC_MAX, after_acceptance, after_rejection, before_step
+from .control import FAC_MAX, after_acceptance, after_rejection, before_step, finish_stats
 from .events import first_contact_switch
+from .hermite import hermite_second_order
 from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
 from .lee_stages import error_norm, rkn_pass, work_increment
-from .monitor import energy_balance, energy_residual, hermite_second_order, init_peaks, update_peaks
+from .lee_work import (L_BUILDS, L_DIAG_UNCONVERGED, L_EPS1, L_IT_ACC, L_IT_DIAG, L_IT_OUT, L_IT_POS, L_IT_VEL,
+                       L_PASSES, L_RATIO_ACC, L_RATIO_POS, L_RATIO_VEL, L_REJ_CONSTRAINT, L_REJ_ERROR, SC_ALPHA,
+                       SC_GN, SC_P_START, SC_W, X_ERR_ACC, X_ERR_POS, X_ERR_VEL, X_H, X_IT_ACC, X_IT_POS, X_IT_VEL,
+                       X_RATIO_ACC, X_RATIO_POS, X_RATIO_VEL, X_REJECTED, X_STEPS)
+from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
 
 # diag's chassis acceleration and the joint forces (output samples, peaks of every accepted step) are those of the
 # state with the multipliers iterated on from the level-4 value to this constraint-acceleration error
@@ -51,133 +61,292 @@ from .monitor import energy_balance, energy_residual, hermite_second_order, init
 DIAG_ACC_TOL = 1e-10
 DIAG_MAX_IT = 1000
 
-# out_x columns: per output sample, over the accepted steps since the previous sample
-X_STEPS, X_REJECTED, X_IT_POS, X_IT_VEL, X_IT_ACC, X_ERR_POS, X_ERR_VEL, X_ERR_ACC, \
-    X_RATIO_POS, X_RATIO_VEL, X_RATIO_ACC, X_H = range(12)
-N_X = 12
-# lstats: run totals
-L_IT_POS, L_IT_VEL, L_IT_ACC, L_PASSES, L_REJ_ERROR, L_REJ_CONSTRAINT, L_EPS1, \
-    L_RATIO_POS, L_RATIO_VEL, L_RATIO_ACC, L_IT_OUT, L_BUILDS, L_IT_DIAG, L_DIAG_UNCONVERGED = range(14)
-N_L = 14
+
+@njit(**KERNEL)
+def _itm(lw):
+    return lw.An, lw.sc[SC_ALPHA], lw.sc[SC_GN]
 
 
-@njit(cache=True, error_model="numpy")
-def _count_diag(it, lstats):
-    """Bookkeeping of the DIAG_ACC_TOL iterations (it < 0: not converged in DIAG_MAX_IT)."""
+@njit(**KERNEL)
+def _reported(F, geo, zd, minv, lam, lw, lstats):
+    """The acceleration level iterated on a copy (lw.lam_d) to DIAG_ACC_TOL: what diag
+    and the joint forces report. Counts the iterations (or one that did not converge)."""
+    copy_into(lw.lam_d, 0, lam)
+    it, _ = acceleration_level(F, geo, zd, minv, lw.lam_d, _itm(lw), DIAG_ACC_TOL, DIAG_MAX_IT,
+                               (lw.zdd_d, lw.gam, lw.v))
     if it < 0:
         lstats[L_DIAG_UNCONVERGED] += 1
     else:
         lstats[L_IT_DIAG] += it
 
 
-@njit(cache=True, error_model="numpy")
-def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0, h_max, h_min, max_steps,
-                  n_acc, n_eps, ptol, max_it, rebuild_angle, minv, par, arms, ends, seg, corners, nbr, ref, work,
-                  out_y, out_d, out_x, out_lam, peaks, stats, lstats):
-    nw = arms.shape[0]
-    nbody = 3 * (1 + nw)
-    nz = minv.shape[0]
-    ns = c.shape[0]
-    nl = 2 * nw
-    nd = out_d.shape[1]
-    n_pins = work[0].shape[0]
-    z = np.empty(nz)
-    zd = np.empty(nz)
-    zdd = np.empty(nz)
-    Y = np.empty(nz)
-    zd_new = np.empty(nz)
-    zdd_new = np.empty(nz)
-    u = np.empty(nz)
-    K = np.zeros((ns, nz))
-    Fst = np.zeros((ns, nz))
-    fcs = np.zeros((ns, n_pins, 2))
-    fws = np.zeros((ns, nw, 2))
-    geos = np.zeros((ns, nw, 4))
-    diags = np.zeros((ns, nd))
-    lam0 = np.zeros(nl)
-    lam1 = np.zeros(nl)
-    lam_prev = np.zeros(nl)
-    lam_s = np.zeros(nl)
-    lam_o = np.zeros(nl)
-    dl = np.zeros(nl)
-    v = np.zeros(nl)
-    gam = np.zeros(nl)
-    G = np.zeros((nl, nl))
-    An = np.zeros((nl, nl))
-    Cn = np.zeros((nl, nl))
-    T = np.zeros((nl, nl))
-    tmp = np.zeros((nl, nl))
-    ya = np.zeros(2 * nz + 1)
-    fa = np.zeros(2 * nz + 1)
-    yb = np.zeros(2 * nz + 1)
-    fb = np.zeros(2 * nz + 1)
-    yo = np.zeros(2 * nz + 1)
-    yred = np.zeros(y0.shape[0])
-    # scratch of the event location (reduced-coordinate views of a rejected step's ends)
-    ev_y0 = np.zeros(y0.shape[0])
-    ev_f0 = np.zeros(y0.shape[0])
-    ev_y1 = np.zeros(y0.shape[0])
-    ev_f1 = np.zeros(y0.shape[0])
-    ev_pins0 = np.empty((n_pins, 2))
-    ev_pins1 = np.empty((n_pins, 2))
-    ev_wheels0 = np.empty((nw, 2))
-    ev_wheels1 = np.empty((nw, 2))
-    Fo = np.zeros(nz)
-    fco = np.zeros((n_pins, 2))
-    geo_o = np.zeros((nw, 4))
-    zdd_o = np.zeros(nz)
-    acc_x = np.zeros(N_X)
-    lam_d = np.zeros(nl)
-    zdd_d = np.zeros(nz)
-    ang_ref = np.zeros(1 + nw)    # chassis pitch and arm angles where A_n was last built
-    lstats[:] = 0.0
-    status = SUCCESSFUL
-    n_rhs = 0
-
-    # t = 0: forces, eps-bar-1 by Eq. (20), then the acceleration level for lambda(0)
-    W = from_reduced(y0, par, arms, z, zd)
-    applied_forces(z, zd, par, arms, ends, seg, corners, nbr, ref, work, Fst[0], fcs[0], diags[0])
-    n_rhs += 1
-    copy_2d(fws[0], work[3])
-    joint_vectors(z, par, arms, geos[0])
-    constraint_matrix(geos[0], minv, G)
-    eps1 = estimate_eps1(Fst[0], geos[0], zd, minv, lam0, inf_norm(G), n_eps, nbody, zdd, gam, v)
-    lstats[L_EPS1] = eps1
-    alpha, gn = accel_matrix(G, n_acc, eps1, An, Cn, T, tmp)
+@njit(**KERNEL)
+def _build_matrices(z, geo, ls, minv, lw, lstats):
+    """A_n and alpha (A1-A6) from C at configuration z (joint vectors geo); remembers
+    the angles they were built at."""
+    constraint_matrix(geo, minv, lw.G)
+    alpha, gn = accel_matrix(lw.G, ls.accel_order, lstats[L_EPS1], lw.An, lw.Cn, lw.T, lw.tmp)
+    lw.sc[SC_ALPHA] = alpha
+    lw.sc[SC_GN] = gn
     lstats[L_BUILDS] += 1
-    ang_ref[0] = z[2]
-    for i in range(nw):
-        ang_ref[1 + i] = z[5 + 3 * i]
-    h = min(h0, h_max)
-    it_a, err_a = acceleration_level(Fst[0], geos[0], zd, minv, lam0, An, alpha, gn, ptol / (h * h), max_it,
-                                     nbody, zdd, gam, v)
+    lw.ang_ref[0] = z[Z_PITCH]
+    for i in range(geo.shape[0]):
+        lw.ang_ref[1 + i] = z[z_arm(i) + ZA_BETA]
+
+
+@njit(**KERNEL)
+def _start(y0, h, ls, minv, m, w, lw, out, lout):
+    """t = 0: forces, eps-bar-1 by Eq. (20), A_n, then the acceleration level for
+    lambda(0); the first sample and the energy references. Returns (status, e_ref, r_ref)."""
+    z, zd, zdd = lw.z, lw.zd, lw.zdd
+    nw = m.arms.shape[0]
+    nbody = z_pin(nw)
+    lstats = lout.lstats
+    lstats[:] = 0.0
+    lw.sc[SC_W] = from_reduced(y0, m.par, m.arms, z, zd)
+    applied_forces(z, zd, m, w, lw.Fst[0], lw.fcs[0], lw.diags[0])
+    copy_2d(lw.fws[0], w.fwheel)
+    joint_vectors(z, m.par, m.arms, lw.geos[0])
+    constraint_matrix(lw.geos[0], minv, lw.G)
+    lstats[L_EPS1] = estimate_eps1(lw.Fst[0], lw.geos[0], zd, minv, lw.lam0, inf_norm(lw.G), ls.eps_iterations,
+                                   nbody, zdd, lw.gam, lw.v)
+    _build_matrices(z, lw.geos[0], ls, minv, lw, lstats)
+    status = SUCCESSFUL
+    it_a, err_a = acceleration_level(lw.Fst[0], lw.geos[0], zd, minv, lw.lam0, _itm(lw), ls.position_tol / (h * h),
+                                     ls.max_iterations, (zdd, lw.gam, lw.v))
     if it_a < 0:
         status = CONSTRAINT_ITERATION
-    for k in range(nbody, nz):
-        zdd[k] = Fst[0, k] * minv[k]
-    set_row(K, 0, zdd)
-    p_start = contact_power(z, zd, ends, fcs[0], fws[0], nw)
-    copy_into(lam_d, 0, lam0)
-    it_d, _ = acceleration_level(Fst[0], geos[0], zd, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT, nbody,
-                                 zdd_d, gam, v)
-    _count_diag(it_d, lstats)
-    finish_diag(z, zd, zdd_d, par, arms, p_start, diags[0])
-    e_ref = energy_balance(diags[0])
-    r_ref = energy_residual(diags[0], W)
-    stats[S_E0] = e_ref - diags[0, D_E_GRAVITY]
-    init_peaks(peaks)
-    update_peaks(peaks, 0.0, diags[0], zd[0], W, e_ref, r_ref, False)
-    to_reduced(z, zd, W, nw, yred)
-    set_row(out_y, 0, yred)
-    set_row(out_d, 0, diags[0])
-    set_row(out_lam, 0, lam_d)  # the converged multipliers, as for diag
-    out_x[0, :] = 0.0
-    out_x[0, X_ERR_ACC] = err_a
-    n_out = 1
-    n_out_max = out_y.shape[0]
-    if diags[0, D_STATUS] != 0.0:
-        status = int(diags[0, D_STATUS])
+    for k in range(nbody, z.shape[0]):
+        zdd[k] = lw.Fst[0, k] * minv[k]
+    set_row(lw.K, 0, zdd)
+    lw.sc[SC_P_START] = contact_power(z, zd, m.ends, lw.fcs[0], lw.fws[0], nw)
+    _reported(lw.Fst[0], lw.geos[0], zd, minv, lw.lam0, lw, lstats)
+    diag = lw.diags[0]
+    finish_diag(z, zd, lw.zdd_d, m.par, m.arms, lw.sc[SC_P_START], diag)
+    e_ref = energy_balance(diag)
+    r_ref = energy_residual(diag, lw.sc[SC_W])
+    out.stats[S_E0] = e_ref - diag[D_E_GRAVITY]
+    init_peaks(out.peaks)
+    update_peaks(out.peaks, 0.0, diag, zd[Z_X], lw.sc[SC_W], e_ref, r_ref, False)
+    to_reduced(z, zd, lw.sc[SC_W], nw, lw.yred)
+    set_row(out.y, 0, lw.yred)
+    set_row(out.diag, 0, diag)
+    set_row(lout.lam, 0, lw.lam_d)  # the converged multipliers, as for diag
+    lout.x[0, :] = 0.0
+    lout.x[0, X_ERR_ACC] = err_a
+    if diag[D_STATUS] != 0.0:
+        status = int(diag[D_STATUS])
+    return status, e_ref, r_ref
 
+
+@njit(**KERNEL)
+def _position_level(h, h_prev, tab, ls, minv, m, w, lw, lstats):
+    """Step 1: re-integrate the step while iterating lam1 with Eq. (12).
+    Returns (converged, final max |Phi|, iterations, stage evaluations)."""
+    lam0, lam1, lam_prev, v = lw.lam0, lw.lam1, lw.lam_prev, lw.v
+    ns = tab.c.shape[0]
+    for r in range(lam1.shape[0]):
+        lam1[r] = lam0[r]
+        if h_prev > 0.0:
+            lam1[r] += h / h_prev * (lam0[r] - lam_prev[r])
+    scale = lw.sc[SC_ALPHA] / (h * h / 6.0 * lw.sc[SC_GN])
+    err_p = np.inf
+    err_first = np.inf
+    n_eval = 0
+    updates = 0
+    ok = False
+    for it in range(ls.max_iterations + 1):
+        rkn_pass(h, tab, minv, m, w, lw)
+        n_eval += ns - 1
+        lstats[L_PASSES] += 1
+        phi(lw.Y, lw.geos[ns - 1], v)
+        for r in range(v.shape[0]):
+            v[r] = -v[r]       # Eq. (12)
+        err_p = max_abs(v)
+        if err_p <= ls.position_tol:
+            ok = True
+            break
+        if it == 0:
+            err_first = err_p
+        if not math.isfinite(err_p) or err_p > 1e3 * err_first:
+            break
+        update(lam1, lw.An, v, scale)
+        updates += 1
+    lstats[L_IT_POS] += updates
+    return ok, err_p, updates, n_eval
+
+
+@njit(**KERNEL)
+def _locate_switch(h, tab, m, ev, lw, nw):
+    """Step 2 on a rejection: the contact switch inside the step, on its ends in reduced
+    coordinates (the last stage, c = 1, is the acceleration at t + h)."""
+    ns = tab.c.shape[0]
+    to_reduced(lw.z, lw.zd, 0.0, nw, lw.ev_y0)
+    to_reduced(lw.zd, lw.zdd, 0.0, nw, lw.ev_f0)
+    to_reduced(lw.Y, lw.zd_new, 0.0, nw, lw.ev_y1)
+    to_reduced(lw.zd_new, lw.K[ns - 1], 0.0, nw, lw.ev_f1)
+    return first_contact_switch(lw.ev_y0, lw.ev_f0, lw.ev_y1, lw.ev_f1, h, m, ev)
+
+
+@njit(**KERNEL)
+def _maybe_rebuild(ls, minv, lw, lstats):
+    """A_n again where the pitch or an arm angle moved more than rebuild_angle."""
+    ns = lw.geos.shape[0]
+    moved = abs(lw.Y[Z_PITCH] - lw.ang_ref[0])
+    for i in range(lw.geos.shape[1]):
+        moved = max(moved, abs(lw.Y[z_arm(i) + ZA_BETA] - lw.ang_ref[1 + i]))
+    if moved > ls.matrix_update_angle:
+        _build_matrices(lw.Y, lw.geos[ns - 1], ls, minv, lw, lstats)
+
+
+@njit(**KERNEL)
+def _velocity_and_acceleration(h, tab, ls, minv, lw, lstats):
+    """Steps 3 and 4: qd(t + h) of the bodies, then lambda(t + h) and qdd(t + h).
+    Returns (velocity iterations, error, acceleration iterations, error)."""
+    ns = tab.c.shape[0]
+    lam_s, geo = lw.lam_s, lw.geos[ns - 1]
+    for r in range(lam_s.shape[0]):
+        lam_s[r] = lw.lam1[r]
+    it_v, err_v = velocity_level(lw.zd_new, geo, lw.geos, tab.bp, tab.c, h, minv, lam_s, _itm(lw),
+                                 ls.position_tol / h, ls.max_iterations, (lw.dl, lw.u, lw.v))
+    for r in range(lam_s.shape[0]):
+        lw.lam_prev[r] = lw.lam0[r]
+        lam_s[r] = lw.lam1[r]
+    it_a, err_a = acceleration_level(lw.Fst[ns - 1], geo, lw.zd_new, minv, lam_s, _itm(lw),
+                                     ls.position_tol / (h * h), ls.max_iterations, (lw.zdd_new, lw.gam, lw.v))
+    lstats[L_IT_VEL] += max(it_v, 0)
+    lstats[L_IT_ACC] += max(it_a, 0)
+    for k in range(z_pin(geo.shape[0]), lw.z.shape[0]):
+        lw.zdd_new[k] = lw.Fst[ns - 1, k] * minv[k]
+    return it_v, err_v, it_a, err_a
+
+
+@njit(**KERNEL)
+def _end_state(h, tab, minv, m, lw, lstats):
+    """The contact work over the step and diag at t + h (the reported multipliers).
+    Returns (W(t + h), p_end)."""
+    ns = tab.c.shape[0]
+    nz = lw.z.shape[0]
+    nw = m.arms.shape[0]
+    p_end = contact_power(lw.Y, lw.zd_new, m.ends, lw.fcs[ns - 1], lw.fws[ns - 1], nw)
+    ya, fa, yb, fb = lw.ya, lw.fa, lw.yb, lw.fb
+    copy_into(ya, 0, lw.z)
+    copy_into(ya, nz, lw.zd)
+    ya[2 * nz] = lw.sc[SC_W]
+    copy_into(fa, 0, lw.zd)
+    copy_into(fa, nz, lw.zdd)
+    fa[2 * nz] = lw.sc[SC_P_START]
+    copy_into(yb, 0, lw.Y)
+    copy_into(yb, nz, lw.zd_new)
+    copy_into(fb, 0, lw.zd_new)
+    copy_into(fb, nz, lw.zdd_new)
+    fb[2 * nz] = p_end
+    w_new = lw.sc[SC_W] + work_increment(h, tab, m.ends, nw, lw.sc[SC_P_START], p_end, lw)
+    yb[2 * nz] = w_new
+    _reported(lw.Fst[ns - 1], lw.geos[ns - 1], lw.zd_new, minv, lw.lam_s, lw, lstats)
+    finish_diag(lw.Y, lw.zd_new, lw.zdd_d, m.par, m.arms, p_end, lw.diags[ns - 1])
+    return w_new, p_end
+
+
+@njit(**KERNEL)
+def _count_step(h, errors, iterations, ptol, lw, lstats):
+    """Figures of an accepted step: into the run totals and the per-sample accumulator."""
+    err_p, err_v, err_a = errors
+    it_p, it_v, it_a = iterations
+    acc_x = lw.acc_x
+    rp = err_p / ptol
+    rv = err_v * h / ptol
+    ra = err_a * h * h / ptol
+    lstats[L_RATIO_POS] = max(lstats[L_RATIO_POS], rp)
+    lstats[L_RATIO_VEL] = max(lstats[L_RATIO_VEL], rv)
+    lstats[L_RATIO_ACC] = max(lstats[L_RATIO_ACC], ra)
+    acc_x[X_STEPS] += 1
+    acc_x[X_IT_POS] += it_p
+    acc_x[X_IT_VEL] += it_v
+    acc_x[X_IT_ACC] += it_a
+    acc_x[X_ERR_POS] = max(acc_x[X_ERR_POS], err_p)
+    acc_x[X_ERR_VEL] = max(acc_x[X_ERR_VEL], err_v)
+    acc_x[X_ERR_ACC] = max(acc_x[X_ERR_ACC], err_a)
+    acc_x[X_RATIO_POS] = max(acc_x[X_RATIO_POS], rp)
+    acc_x[X_RATIO_VEL] = max(acc_x[X_RATIO_VEL], rv)
+    acc_x[X_RATIO_ACC] = max(acc_x[X_RATIO_ACC], ra)
+    acc_x[X_H] = h
+
+
+@njit(**KERNEL)
+def _samples(t, h, n_out, ctl, ls, minv, m, w, lw, out, lout):
+    """Output samples in (t, t + h]: Hermite state, forces, the acceleration level with
+    lambda interpolated over the step. Returns (new sample count, evaluations)."""
+    nz = lw.z.shape[0]
+    nw = m.arms.shape[0]
+    nbody = z_pin(nw)
+    yo, Fo, fco, geo_o, lam_o = lw.yo, lw.Fo, lw.fco, lw.geo_o, lw.lam_o
+    lstats = lout.lstats
+    n_eval = 0
+    while n_out < out.y.shape[0] and n_out * ctl.dt_out <= (t + h) * (1.0 + 1e-12):
+        theta = min(1.0, (n_out * ctl.dt_out - t) / h)
+        hermite_second_order(lw.ya, lw.fa, lw.yb, lw.fb, h, theta, nz, yo)
+        zo = yo[:nz]
+        zdo = yo[nz:2 * nz]
+        applied_forces(zo, zdo, m, w, Fo, fco, out.diag[n_out])
+        n_eval += 1
+        joint_vectors(zo, m.par, m.arms, geo_o)
+        for r in range(lam_o.shape[0]):
+            lam_o[r] = lw.lam0[r] + theta * (lw.lam_s[r] - lw.lam0[r])
+        it_o, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_o, _itm(lw), ls.position_tol / (h * h),
+                                     ls.max_iterations, (lw.zdd_o, lw.gam, lw.v))
+        lstats[L_IT_OUT] += max(it_o, 0)
+        _reported(Fo, geo_o, zdo, minv, lam_o, lw, lstats)
+        finish_diag(zo, zdo, lw.zdd_d, m.par, m.arms, contact_power(zo, zdo, m.ends, fco, w.fwheel, nw),
+                    out.diag[n_out])
+        to_reduced(zo, zdo, yo[2 * nz], nw, lw.yred)
+        set_row(out.y, n_out, lw.yred)
+        set_row(lout.lam, n_out, lw.lam_d)
+        set_row(lout.x, n_out, lw.acc_x)
+        lw.acc_x[:] = 0.0
+        lw.acc_x[X_H] = h
+        n_out += 1
+    return n_out, n_eval
+
+
+@njit(**KERNEL)
+def _shift(w_new, p_end, lw):
+    """The end of this step is the start of the next."""
+    ns = lw.K.shape[0]
+    copy_into(lw.z, 0, lw.Y)
+    copy_into(lw.zd, 0, lw.zd_new)
+    copy_into(lw.zdd, 0, lw.zdd_new)
+    lw.sc[SC_W] = w_new
+    lw.sc[SC_P_START] = p_end
+    set_row(lw.K, 0, lw.zdd_new)
+    set_row(lw.Fst, 0, lw.Fst[ns - 1])
+    copy_2d(lw.fcs[0], lw.fcs[ns - 1])
+    copy_2d(lw.fws[0], lw.fws[ns - 1])
+    copy_2d(lw.geos[0], lw.geos[ns - 1])
+    copy_into(lw.lam0, 0, lw.lam_s)
+
+
+@njit(**KERNEL)
+def _accepted_status(lw):
+    status = SUCCESSFUL
+    for k in range(lw.z.shape[0]):
+        if not (math.isfinite(lw.Y[k]) and math.isfinite(lw.zd_new[k])):
+            status = NAN
+    diag = lw.diags[lw.diags.shape[0] - 1]
+    if diag[D_STATUS] != 0.0:
+        status = int(diag[D_STATUS])
+    return status
+
+
+@njit(**KERNEL)
+def integrate_lee(y0, ctl, tab, ls, minv, m, w, ev, lw, out, lout):
+    """The paper's procedure (module docstring) from the reduced state y0 to ctl.t_end."""
+    nw = m.arms.shape[0]
+    lstats = lout.lstats
+    h = min(ctl.h0, ctl.h_max)
+    status, e_ref, r_ref = _start(y0, h, ls, minv, m, w, lw, out, lout)
+    n_rhs = 1
+    n_out = 1
     t = 0.0
     h_prev = 0.0
     steps = 0
@@ -186,190 +355,51 @@ def integrate_lee(y0, t_end, dt_out, A, b, bp, c, eb, ebp, expo, rtol, atol, h0,
     h_hi = 0.0
     fac_max = FAC_MAX
     at_switch = False  # the step being tried ends just after a located contact switch
-    while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
-        status, h = before_step(t, h, t_end, steps, rejected, max_steps, h_min)
+    while status == SUCCESSFUL and t < ctl.t_end * (1.0 - 1e-14):
+        status, h = before_step(t, h, ctl.t_end, steps, rejected, ctl.max_steps, ctl.h_min)
         if status != SUCCESSFUL:
             break
-        # ---- 1: position level, re-integrating the step at each iteration
-        for m in range(nl):
-            lam1[m] = lam0[m]
-            if h_prev > 0.0:
-                lam1[m] += h / h_prev * (lam0[m] - lam_prev[m])
-        scale = alpha / (h * h / 6.0 * gn)
-        ok = False
-        err_p = np.inf
-        err_first = np.inf
-        it_p = 0
-        for it in range(max_it + 1):
-            rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corners, nbr, ref, work,
-                     Fst, fcs, fws, geos, diags, lam_s, Y, zd_new)
-            n_rhs += ns - 1
-            lstats[L_PASSES] += 1
-            phi(Y, geos[ns - 1], v)
-            for m in range(nl):
-                v[m] = -v[m]       # Eq. (12)
-            err_p = max_abs(v)
-            if err_p <= ptol:
-                ok = True
-                break
-            if it == 0:
-                err_first = err_p
-            if not math.isfinite(err_p) or err_p > 1e3 * err_first:
-                break
-            update(lam1, An, v, scale)
-            it_p += 1
-        lstats[L_IT_POS] += it_p
+        ok, err_p, it_p, n_eval = _position_level(h, h_prev, tab, ls, minv, m, w, lw, lstats)   # 1
+        n_rhs += n_eval
         if not ok:
             rejected += 1
             lstats[L_REJ_CONSTRAINT] += 1
-            acc_x[X_REJECTED] += 1
+            lw.acc_x[X_REJECTED] += 1
             at_switch = False
             h *= 0.5
             fac_max = 1.0
             continue
-        # ---- 2: error estimate, accept or reject
-        err = error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol)
+        err = error_norm(lw.z, lw.zd, lw.Y, lw.zd_new, lw.K, tab.eb, tab.ebp, h, ctl.rtol, ctl.atol)   # 2
         if not (err <= 1.0):
             rejected += 1
             lstats[L_REJ_ERROR] += 1
-            acc_x[X_REJECTED] += 1
-            th = 2.0
-            if err == err and err > 0.0:
-                # a contact starting or ending inside the step: end the retry just after it
-                # (solvers/events.py, on the step's ends in reduced coordinates; the last
-                # stage, c = 1, is the acceleration at t + h)
-                to_reduced(z, zd, 0.0, nw, ev_y0)
-                to_reduced(zd, zdd, 0.0, nw, ev_f0)
-                to_reduced(Y, zd_new, 0.0, nw, ev_y1)
-                to_reduced(zd_new, K[ns - 1], 0.0, nw, ev_f1)
-                th = first_contact_switch(ev_y0, ev_f0, ev_y1, ev_f1, h, par, arms, ends, seg, corners, nbr,
-                                          ev_pins0, ev_pins1, ev_wheels0, ev_wheels1)
-            h, at_switch = after_rejection(h, err, expo, th, h_min)
+            lw.acc_x[X_REJECTED] += 1
+            th = _locate_switch(h, tab, m, ev, lw, nw) if (err == err and err > 0.0) else 2.0
+            h, at_switch = after_rejection(h, err, tab.expo, th, ctl.h_min)
             fac_max = 1.0
             continue
         t_new = t + h
         steps += 1
         h_lo = min(h_lo, h)
         h_hi = max(h_hi, h)
-        moved = abs(Y[2] - ang_ref[0])
-        for i in range(nw):
-            moved = max(moved, abs(Y[5 + 3 * i] - ang_ref[1 + i]))
-        if moved > rebuild_angle:
-            constraint_matrix(geos[ns - 1], minv, G)
-            alpha, gn = accel_matrix(G, n_acc, eps1, An, Cn, T, tmp)
-            lstats[L_BUILDS] += 1
-            ang_ref[0] = Y[2]
-            for i in range(nw):
-                ang_ref[1 + i] = Y[5 + 3 * i]
-        # ---- 3: velocity level (lambda starts from the position-level end value)
-        for m in range(nl):
-            lam_s[m] = lam1[m]
-        it_v, err_v = velocity_level(zd_new, geos[ns - 1], geos, bp, c, h, minv, lam_s, An, alpha, gn,
-                                     ptol / h, max_it, nbody, dl, u, v)
-        # ---- 4: acceleration level: lambda(t + h), qdd(t + h)
-        for m in range(nl):
-            lam_prev[m] = lam0[m]
-            lam_s[m] = lam1[m]
-        it_a, err_a = acceleration_level(Fst[ns - 1], geos[ns - 1], zd_new, minv, lam_s, An, alpha, gn,
-                                         ptol / (h * h), max_it, nbody, zdd_new, gam, v)
+        _maybe_rebuild(ls, minv, lw, lstats)
+        it_v, err_v, it_a, err_a = _velocity_and_acceleration(h, tab, ls, minv, lw, lstats)   # 3, 4
         if it_v < 0 or it_a < 0:
             status = CONSTRAINT_ITERATION
-        lstats[L_IT_VEL] += max(it_v, 0)
-        lstats[L_IT_ACC] += max(it_a, 0)
-        for k in range(nbody, nz):
-            zdd_new[k] = Fst[ns - 1, k] * minv[k]
-        # contact work and the diagnostics at t + h
-        p_end = contact_power(Y, zd_new, ends, fcs[ns - 1], fws[ns - 1], nw)
-        copy_into(ya, 0, z)
-        copy_into(ya, nz, zd)
-        ya[2 * nz] = W
-        copy_into(fa, 0, zd)
-        copy_into(fa, nz, zdd)
-        fa[2 * nz] = p_start
-        copy_into(yb, 0, Y)
-        copy_into(yb, nz, zd_new)
-        copy_into(fb, 0, zd_new)
-        copy_into(fb, nz, zdd_new)
-        fb[2 * nz] = p_end
-        W_new = W + work_increment(ya, fa, yb, fb, h, bp, c, fcs, fws, ends, nw, p_start, p_end, yo)
-        yb[2 * nz] = W_new
-        diag = diags[ns - 1]
-        copy_into(lam_d, 0, lam_s)
-        it_d, _ = acceleration_level(Fst[ns - 1], geos[ns - 1], zd_new, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL,
-                                     DIAG_MAX_IT, nbody, zdd_d, gam, v)
-        _count_diag(it_d, lstats)
-        finish_diag(Y, zd_new, zdd_d, par, arms, p_end, diag)
-        for k in range(nz):
-            if not (math.isfinite(Y[k]) and math.isfinite(zd_new[k])):
-                status = NAN
-        if diag[D_STATUS] != 0.0:
-            status = int(diag[D_STATUS])
-        update_peaks(peaks, t_new, diag, zd_new[0], W_new, e_ref, r_ref, at_switch)
+        w_new, p_end = _end_state(h, tab, minv, m, lw, lstats)
+        accepted = _accepted_status(lw)
+        if accepted != SUCCESSFUL:
+            status = accepted
+        update_peaks(out.peaks, t_new, lw.diags[lw.diags.shape[0] - 1], lw.zd_new[Z_X], w_new, e_ref, r_ref,
+                     at_switch)
         at_switch = False
-        rp = err_p / ptol
-        rv = err_v * h / ptol
-        ra = err_a * h * h / ptol
-        lstats[L_RATIO_POS] = max(lstats[L_RATIO_POS], rp)
-        lstats[L_RATIO_VEL] = max(lstats[L_RATIO_VEL], rv)
-        lstats[L_RATIO_ACC] = max(lstats[L_RATIO_ACC], ra)
-        acc_x[X_STEPS] += 1
-        acc_x[X_IT_POS] += it_p
-        acc_x[X_IT_VEL] += it_v
-        acc_x[X_IT_ACC] += it_a
-        acc_x[X_ERR_POS] = max(acc_x[X_ERR_POS], err_p)
-        acc_x[X_ERR_VEL] = max(acc_x[X_ERR_VEL], err_v)
-        acc_x[X_ERR_ACC] = max(acc_x[X_ERR_ACC], err_a)
-        acc_x[X_RATIO_POS] = max(acc_x[X_RATIO_POS], rp)
-        acc_x[X_RATIO_VEL] = max(acc_x[X_RATIO_VEL], rv)
-        acc_x[X_RATIO_ACC] = max(acc_x[X_RATIO_ACC], ra)
-        acc_x[X_H] = h
-        # ---- output samples in (t, t + h]
-        while n_out < n_out_max and n_out * dt_out <= t_new * (1.0 + 1e-12):
-            theta = min(1.0, (n_out * dt_out - t) / h)
-            hermite_second_order(ya, fa, yb, fb, h, theta, nz, yo)
-            zo = yo[:nz]
-            zdo = yo[nz:2 * nz]
-            applied_forces(zo, zdo, par, arms, ends, seg, corners, nbr, ref, work, Fo, fco, out_d[n_out])
-            n_rhs += 1
-            joint_vectors(zo, par, arms, geo_o)
-            for m in range(nl):
-                lam_o[m] = lam0[m] + theta * (lam_s[m] - lam0[m])
-            it_o, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_o, An, alpha, gn, ptol / (h * h), max_it,
-                                         nbody, zdd_o, gam, v)
-            lstats[L_IT_OUT] += max(it_o, 0)
-            copy_into(lam_d, 0, lam_o)
-            it_d, _ = acceleration_level(Fo, geo_o, zdo, minv, lam_d, An, alpha, gn, DIAG_ACC_TOL, DIAG_MAX_IT,
-                                         nbody, zdd_d, gam, v)
-            _count_diag(it_d, lstats)
-            finish_diag(zo, zdo, zdd_d, par, arms, contact_power(zo, zdo, ends, fco, work[3], nw), out_d[n_out])
-            to_reduced(zo, zdo, yo[2 * nz], nw, yred)
-            set_row(out_y, n_out, yred)
-            set_row(out_lam, n_out, lam_d)
-            set_row(out_x, n_out, acc_x)
-            acc_x[:] = 0.0
-            acc_x[X_H] = h
-            n_out += 1
-        # ---- shift: the end of this step is the start of the next
+        _count_step(h, (err_p, err_v, err_a), (it_p, it_v, it_a), ls.position_tol, lw, lstats)
+        n_new, n_eval = _samples(t, h, n_out, ctl, ls, minv, m, w, lw, out, lout)
+        n_rhs += n_eval
+        n_out = n_new
         t = t_new
-        copy_into(z, 0, Y)
-        copy_into(zd, 0, zd_new)
-        copy_into(zdd, 0, zdd_new)
-        W = W_new
-        p_start = p_end
-        set_row(K, 0, zdd_new)
-        set_row(Fst, 0, Fst[ns - 1])
-        copy_2d(fcs[0], fcs[ns - 1])
-        copy_2d(fws[0], fws[ns - 1])
-        copy_2d(geos[0], geos[ns - 1])
-        copy_into(lam0, 0, lam_s)
+        _shift(w_new, p_end, lw)
         h_prev = h
-        h = after_acceptance(h, err, expo, fac_max, h_max)
+        h = after_acceptance(h, err, tab.expo, fac_max, ctl.h_max)
         fac_max = FAC_MAX
-    stats[S_STATUS] = status
-    stats[S_T_FINAL] = t
-    stats[S_STEPS] = steps
-    stats[S_REJECTED] = rejected
-    stats[S_RHS] = n_rhs
-    stats[S_N_OUT] = n_out
-    stats[S_H_MIN] = h_lo
-    stats[S_H_MAX] = h_hi
+    finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)

@@ -16,32 +16,35 @@ import math
 from numba import njit
 
 from ..model.absolute import add_phi_qt, applied_forces, contact_power, joint_vectors
+from ..model.jit import KERNEL
 from .arrays import copy_2d
-from .monitor import hermite_second_order
+from .hermite import hermite_second_order
 
 
-@njit(cache=True, error_model="numpy")
-def rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corners, nbr, ref, work,
-             Fst, fcs, fws, geos, diags, lam_s, Y, zd_new):
-    """Stages 2..s of the RKN pair with lambda linear from lam0 to lam1 (stage 1, K[0],
-    is the acceleration at t). Contacts are re-detected at every stage. On return
-    Y = z(t + h) (last stage, first same as last), zd_new = zd(t + h); per stage j the
-    applied forces Fst[j], contact forces fcs[j] (pins) and fws[j] (wheels), joint
-    geometry geos[j] and the track_loads diagnostics diags[j]."""
+@njit(**KERNEL)
+def rkn_pass(h, tab, minv, m, w, lw):
+    """Stages 2..s of the RKN pair from (lw.z, lw.zd) with lambda linear from lw.lam0 to
+    lw.lam1 (stage 1, K[0], is the acceleration at t). Contacts are re-detected at every
+    stage. On return lw.Y = z(t + h) (last stage, first same as last), lw.zd_new =
+    zd(t + h); per stage j the applied forces Fst[j], contact forces fcs[j] (pins) and
+    fws[j] (wheels), joint geometry geos[j] and the track_loads diagnostics diags[j]."""
+    A, bp, c = tab.A, tab.bp, tab.c
+    z, zd, K, Y, zd_new, lam0, lam1, lam_s = lw.z, lw.zd, lw.K, lw.Y, lw.zd_new, lw.lam0, lw.lam1, lw.lam_s
+    Fst, fcs, fws, geos, diags = lw.Fst, lw.fcs, lw.fws, lw.geos, lw.diags
+    par, arms = m.par, m.arms
     ns = c.shape[0]
     nz = z.shape[0]
-    fwheel = work[3]
     for i in range(1, ns):
         for k in range(nz):
             acc = 0.0
             for j in range(i):
                 acc += A[i, j] * K[j, k]
             Y[k] = z[k] + c[i] * h * zd[k] + h * h * acc
-        applied_forces(Y, zd, par, arms, ends, seg, corners, nbr, ref, work, Fst[i], fcs[i], diags[i])
-        copy_2d(fws[i], fwheel)
+        applied_forces(Y, zd, m, w, Fst[i], fcs[i], diags[i])
+        copy_2d(fws[i], w.fwheel)
         joint_vectors(Y, par, arms, geos[i])
-        for m in range(lam_s.shape[0]):
-            lam_s[m] = lam0[m] + c[i] * (lam1[m] - lam0[m])
+        for r in range(lam_s.shape[0]):
+            lam_s[r] = lam0[r] + c[i] * (lam1[r] - lam0[r])
         Ki = K[i]
         for k in range(nz):
             Ki[k] = Fst[i, k]
@@ -55,7 +58,7 @@ def rkn_pass(z, zd, K, h, lam0, lam1, A, bp, c, minv, par, arms, ends, seg, corn
         zd_new[k] = zd[k] + h * acc
 
 
-@njit(cache=True, error_model="numpy")
+@njit(**KERNEL)
 def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     """RMS over positions and velocities of the embedded estimate (h^2 sum eb k, h sum ebp k)
     scaled by atol + rtol max(|old|, |new|)."""
@@ -75,13 +78,15 @@ def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     return math.sqrt(s / (2 * nz))
 
 
-@njit(cache=True, error_model="numpy")
-def work_increment(ya, fa, yb, fb, h, bp, c, fcs, fws, ends, nw, p_start, p_end, yo):
+@njit(**KERNEL)
+def work_increment(h, tab, ends, nw, p_start, p_end, lw):
     """Contact work over the step: W' = P(t) = contact force . velocity, integrated by the
     pair's velocity weights, h sum_j bp_j P_j (exact for polynomials of degree 5 in time):
     P_j pairs the contact forces found at stage j (the forces the step used) with the
     velocity at t + c_j h from the quintic Hermite interpolant of the accepted step
-    (ya, fa: (z, zd, -), (zd, zdd, -) at t; yb, fb at t + h). P_1, P_s are exact."""
+    (lw.ya, lw.fa: (z, zd, -), (zd, zdd, -) at t; lw.yb, lw.fb at t + h). P_1, P_s are exact."""
+    ya, fa, yb, fb, yo, fcs, fws = lw.ya, lw.fa, lw.yb, lw.fb, lw.yo, lw.fcs, lw.fws
+    bp, c = tab.bp, tab.c
     nz = (ya.shape[0] - 1) // 2
     ns = c.shape[0]
     acc = bp[0] * p_start + bp[ns - 1] * p_end

@@ -19,12 +19,15 @@ member DOPRIN used could not be checked here, so the pair is named for its sourc
 The table is checked against the order conditions below at import.
 """
 
+from collections import namedtuple
 from dataclasses import dataclass
 from math import factorial, sqrt
 
 import numpy as np
 
 from .tableau import lower_triangular
+
+RknArrays = namedtuple("RknArrays", ["A", "b", "bp", "c", "eb", "ebp", "expo"])
 
 R = sqrt(8581.0)
 
@@ -111,9 +114,9 @@ class NystromPair:
         return len(self.c)
 
     def arrays(self):
-        """(A, b, bp, c, eb, ebp, step-size exponent) as float arrays."""
-        return (lower_triangular(self.a), np.array(self.b), np.array(self.bp), np.array(self.c), np.array(self.eb),
-                np.array(self.ebp), -1.0 / (self.error_order + 1))
+        """RknArrays (A, b, bp, c, eb, ebp, step-size exponent) for the compiled loop."""
+        return RknArrays(lower_triangular(self.a), np.array(self.b), np.array(self.bp), np.array(self.c),
+                         np.array(self.eb), np.array(self.ebp), -1.0 / (self.error_order + 1))
 
 
 RKN64 = NystromPair("rkn6(4)6fd", 6, 4, tuple(_C), tuple(map(tuple, _A)), tuple(_B), tuple(_BP),
