@@ -11,6 +11,8 @@ import xarray as xr
 
 from . import __version__
 from .model import layout as L
+from .model.energy import paper_balance, work_residual
+from .model.kinematics import place_samples
 from .status import Result
 
 MODEL_VERSION = "1"  # bump when a change to the model or solvers changes results
@@ -20,38 +22,19 @@ def _var(dims, data, units, long_name, **attrs):
     return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
 
 
-def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solve_time):
-    nw, nl = model.nw, model.n_links
+T, WH, P, K = ("time",), ("time", "wheel"), ("time", "pin"), ("time", "link")
+
+
+def _motion(model, result):
+    """Chassis, arms, wheels and pins, placed by the kernels' own kinematics."""
+    nw, nl, n = model.nw, model.n_links, len(result.time)
     nq = L.n_coordinates(nw, nl)
-    y, d = result.y, result.diag
-    q, qd = y[:, :nq], y[:, nq:2 * nq]
-    work, dissipated = y[:, 2 * nq + L.Y_WORK], y[:, 2 * nq + L.Y_DISSIPATED]
-    off = L.pin_offset(nw)
-    n = len(result.time)
-    # pins 0 and n_links ride on the chassis
-    c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
-    pin_x = np.empty((n, nl + 1))
-    pin_y = np.empty((n, nl + 1))
-    pin_x[:, 1:nl] = q[:, off::2]
-    pin_y[:, 1:nl] = q[:, off + 1::2]
-    for col, (bx, by) in ((0, model.ends[0]), (nl, model.ends[1])):
-        pin_x[:, col] = q[:, L.Q_X] + c * bx - s * by
-        pin_y[:, col] = q[:, L.Q_Y] + s * bx + c * by
-    beta = q[:, L.Q_PITCH, None] + q[:, L.Q_ARM:L.Q_ARM + nw]
-    la = model.par[L.P_ARM_LENGTH]
-    wx = q[:, L.Q_X, None] + c[:, None] * model.arms[:, 0] - s[:, None] * model.arms[:, 1] + la * np.cos(beta)
-    wy = q[:, L.Q_Y, None] + s[:, None] * model.arms[:, 0] + c[:, None] * model.arms[:, 1] + la * np.sin(beta)
+    q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
+    pins = np.empty((n, nl + 1, 2))
+    wheels = np.empty((n, nw, 2))
+    place_samples(np.ascontiguousarray(q), model.par, model.arms, model.ends, pins, wheels)
     wheel_f = d[:, L.D_WHEEL:L.D_WHEEL + 2 * nw].reshape(n, nw, 2)
-    tension = d[:, L.diag_tension(nw):L.diag_tension(nw) + nl]
-    elastic = d[:, L.D_E_TORSION] + d[:, L.D_E_TENSION] + d[:, L.D_E_PAD_WHEEL] + d[:, L.D_E_PAD_GROUND]
-    grav = d[:, L.D_E_GRAVITY] - d[0, L.D_E_GRAVITY]
-    kin = d[:, L.D_E_KINETIC]
-    e0 = result.stats[L.S_E0]
-    balance = kin + elastic + grav
-    residual = (kin + d[:, L.D_E_TORSION] + d[:, L.D_E_TENSION] + grav - work)
-    residual = residual - residual[0]
-    T, W, P, K = ("time",), ("time", "wheel"), ("time", "pin"), ("time", "link")
-    v = {
+    return {
         "chassis_x": _var(T, q[:, L.Q_X], "m", "chassis mass-centre x"),
         "chassis_y": _var(T, q[:, L.Q_Y], "m", "chassis mass-centre height"),
         "chassis_pitch": _var(T, q[:, L.Q_PITCH], "rad", "chassis pitch, positive raises the front"),
@@ -59,20 +42,35 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "chassis_vy": _var(T, qd[:, L.Q_Y], "m s-1", "chassis mass-centre vertical velocity"),
         "chassis_ax": _var(T, d[:, L.D_CHASSIS_AX], "m s-2", "chassis mass-centre horizontal acceleration"),
         "chassis_ay": _var(T, d[:, L.D_CHASSIS_AY], "m s-2", "chassis mass-centre vertical acceleration"),
-        "arm_angle": _var(W, q[:, L.Q_ARM:L.Q_ARM + nw], "rad",
+        "arm_angle": _var(WH, q[:, L.Q_ARM:L.Q_ARM + nw], "rad",
                           "torsion-bar arm angle phi (pivot to wheel centre) relative to the chassis x axis"),
-        "wheel_x": _var(W, wx, "m", "road-wheel centre x"),
-        "wheel_y": _var(W, wy, "m", "road-wheel centre y"),
-        "wheel_force_x": _var(W, wheel_f[:, :, 0], "N", "horizontal wheel-track contact force on the wheel"),
-        "wheel_force_y": _var(W, wheel_f[:, :, 1], "N", "vertical wheel-track contact force on the wheel"),
+        "wheel_x": _var(WH, wheels[:, :, 0], "m", "road-wheel centre x"),
+        "wheel_y": _var(WH, wheels[:, :, 1], "m", "road-wheel centre y"),
+        "wheel_force_x": _var(WH, wheel_f[:, :, 0], "N", "horizontal wheel-track contact force on the wheel"),
+        "wheel_force_y": _var(WH, wheel_f[:, :, 1], "N", "vertical wheel-track contact force on the wheel"),
         "ground_force_x": _var(T, d[:, L.D_GROUND_FX], "N", "total horizontal ground force on the track"),
         "ground_force_y": _var(T, d[:, L.D_GROUND_FY], "N", "total vertical ground force on the track"),
         "obstacle_force": _var(T, d[:, L.D_CORNER_FORCE], "N", "sum of the ground-corner contact forces"),
-        "pin_x": _var(P, pin_x, "m", "track pin x (pins 0 and last fixed to the chassis)"),
-        "pin_y": _var(P, pin_y, "m", "track pin y"),
-        "link_tension": _var(K, tension, "N", "link tension, Eq. (8); negative is compression"),
+        "pin_x": _var(P, pins[:, :, 0], "m", "track pin x (pins 0 and last fixed to the chassis)"),
+        "pin_y": _var(P, pins[:, :, 1], "m", "track pin y"),
+        "link_tension": _var(K, d[:, L.diag_tension(nw):L.diag_tension(nw) + nl], "N",
+                             "link tension, Eq. (8) (with the link dashpot if any); negative is compression"),
+    }
+
+
+def _energies(result, nq):
+    """The paper's balance and the work-based residual (model/energy.py), relative to E0."""
+    d, y = result.diag, result.y
+    work, dissipated = y[:, 2 * nq + L.Y_WORK], y[:, 2 * nq + L.Y_DISSIPATED]
+    kin, tors, tens = d[:, L.D_E_KINETIC], d[:, L.D_E_TORSION], d[:, L.D_E_TENSION]
+    grav = d[:, L.D_E_GRAVITY] - d[0, L.D_E_GRAVITY]
+    e0 = result.stats[L.S_E0]
+    balance = paper_balance(kin, tors, tens, d[:, L.D_E_PAD_WHEEL], d[:, L.D_E_PAD_GROUND], grav)
+    residual = work_residual(kin, tors, tens, grav, work)
+    return {
         "energy_kinetic": _var(T, kin, "J", "kinetic energy"),
-        "energy_elastic": _var(T, elastic, "J", "elastic energy: torsion bars, links, wheel and ground pads"),
+        "energy_elastic": _var(T, tors + tens + d[:, L.D_E_PAD_WHEEL] + d[:, L.D_E_PAD_GROUND], "J",
+                               "elastic energy: torsion bars, links, wheel and ground pads"),
         "energy_gravity": _var(T, grav, "J", "gravity potential relative to t = 0"),
         "energy_balance": _var(T, balance, "J", "paper's energy balance: kinetic + elastic + gravity potential"),
         "energy_balance_error": _var(T, (balance - balance[0]) / e0, "1",
@@ -80,48 +78,48 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "contact_work": _var(T, work, "J", "work done by all contact forces and dampers since t = 0"),
         "energy_dissipated": _var(T, dissipated, "J", "energy dissipated by all dampers since t = 0 (contact "
                                   "damping, link dashpots, shock absorbers); 0 in the paper's model"),
-        "energy_residual": _var(T, residual / e0, "1",
-                                "work-based residual: kinetic + torsion + tension + gravity - contact work, "
-                                "change since t = 0 relative to the initial total energy"),
+        "energy_residual": _var(T, (residual - residual[0]) / e0, "1",
+                                "work-based residual: kinetic + torsion + tension + gravity - work of the "
+                                "contact forces and dampers, change since t = 0 relative to the initial total "
+                                "energy"),
     }
-    pk = result.peaks
-    v["peak_wheel_force_y"] = _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 0], "N",
-                                   "max vertical wheel-track force over all accepted steps")
-    v["peak_wheel_force_y_time"] = _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 1], "s",
-                                        "time of peak_wheel_force_y")
 
-    def scalar(name, row, units, text, scale=1.0):
-        v[name] = _var((), pk[row, 0] * scale, units, text + " over all accepted steps")
+
+_SCALAR_PEAKS = [  # name, peaks row, units, text, divided by E0
+    ("peak_ground_force_y", L.PK_GROUND_FY, "N", "max total vertical ground force", False),
+    ("peak_link_tension", L.PK_TENSION_MAX, "N", "max link tension", False),
+    ("min_link_tension", L.PK_TENSION_MIN, "N", "min link tension", False),
+    ("peak_chassis_ay", L.PK_AY_MAX, "m s-2", "max chassis vertical acceleration", False),
+    ("min_chassis_ay", L.PK_AY_MIN, "m s-2", "min chassis vertical acceleration", False),
+    ("min_chassis_vx", L.PK_VX_MIN, "m s-1", "min chassis horizontal velocity", False),
+    ("max_energy_balance_error", L.PK_ENERGY_BALANCE, "1", "max |energy balance deviation| / E0", True),
+    ("max_energy_residual", L.PK_ENERGY_RESIDUAL, "1", "max |work-based energy residual| / E0", True),
+]
+_FIRST_TIMES = [  # name, peaks row, text
+    ("first_contact_time", L.PK_FIRST_OBSTACLE, "first accepted step with the track touching an obstacle (its "
+     "face, corner or top: any ground feature after the first segment)"),
+    ("first_corner_contact_time", L.PK_FIRST_CORNER, "first accepted step with a ground corner touching the track"),
+    ("first_compression_time", L.PK_FIRST_COMPRESSION, "first time a link goes into compression (linear between "
+     "steps) (after it the motion is sensitive, see results_schema.md)"),
+]
+
+
+def _peaks(pk, nw, e0):
+    v = {"peak_wheel_force_y": _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 0], "N",
+                                    "max vertical wheel-track force over all accepted steps"),
+         "peak_wheel_force_y_time": _var(("wheel",), pk[L.PK_WHEEL_FY:L.PK_WHEEL_FY + nw, 1], "s",
+                                         "time of peak_wheel_force_y")}
+    for name, row, units, text, relative in _SCALAR_PEAKS:
+        v[name] = _var((), pk[row, 0] * (1 / e0 if relative else 1.0), units, text + " over all accepted steps")
         v[name + "_time"] = _var((), pk[row, 1], "s", "time of " + name)
+    for name, row, text in _FIRST_TIMES:
+        v[name] = _var((), pk[row, 1] if pk[row, 0] > 0 else np.nan, "s", text)
+    return v
 
-    scalar("peak_ground_force_y", L.PK_GROUND_FY, "N", "max total vertical ground force")
-    scalar("peak_link_tension", L.PK_TENSION_MAX, "N", "max link tension")
-    scalar("min_link_tension", L.PK_TENSION_MIN, "N", "min link tension")
-    scalar("peak_chassis_ay", L.PK_AY_MAX, "m s-2", "max chassis vertical acceleration")
-    scalar("min_chassis_ay", L.PK_AY_MIN, "m s-2", "min chassis vertical acceleration")
-    scalar("min_chassis_vx", L.PK_VX_MIN, "m s-1", "min chassis horizontal velocity")
-    scalar("max_energy_balance_error", L.PK_ENERGY_BALANCE, "1", "max |energy balance deviation| / E0", 1 / e0)
-    scalar("max_energy_residual", L.PK_ENERGY_RESIDUAL, "1", "max |work-based energy residual| / E0", 1 / e0)
-    first = pk[L.PK_FIRST_OBSTACLE, 1] if pk[L.PK_FIRST_OBSTACLE, 0] > 0 else np.nan
-    corner = pk[L.PK_FIRST_CORNER, 1] if pk[L.PK_FIRST_CORNER, 0] > 0 else np.nan
-    comp = pk[L.PK_FIRST_COMPRESSION, 1] if pk[L.PK_FIRST_COMPRESSION, 0] > 0 else np.nan
-    v["first_contact_time"] = _var((), first, "s", "first accepted step with the track touching an obstacle "
-                                   "(its face, corner or top: any ground feature after the first segment)")
-    v["first_corner_contact_time"] = _var((), corner, "s", "first accepted step with a ground corner touching the "
-                                          "track")
-    v["first_compression_time"] = _var((), comp, "s", "first time a link goes into compression (linear between steps) "
-                                       "(after it the motion is sensitive, see results_schema.md)")
-    for name, arr in result.extra.items():
-        v[name] = arr
-    coords = {
-        "time": _var(T, result.time, "s", "simulated time"),
-        "wheel": _var(("wheel",), np.arange(1, nw + 1), "1", "road wheel number, 1 = front"),
-        "pin": _var(("pin",), np.arange(nl + 1), "1", "track pin number, 0 = front track end"),
-        "link": _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1)"),
-    }
-    st = result.stats
+
+def _attrs(scenario, model, eq, ground, resolved, st, wall_time, solve_time):
     status = Result(int(st[L.S_STATUS]))
-    attrs = {
+    return {
         "Conventions": "CF-1.11",
         "title": f"trackbench run: {scenario.name}",
         "trackbench_version": __version__,
@@ -141,19 +139,37 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "neighbour_rebuilds": model.neighbour_rebuilds,
         "wall_time": wall_time,
         "solve_time": solve_time,
-        "initial_total_energy": float(e0),
+        "initial_total_energy": float(st[L.S_E0]),
         "weight": float(model.weight),
         "scenario": json.dumps(scenario.to_dict(), sort_keys=True),
         "terrain_resolved": json.dumps(resolved),
         "ground_vertices": json.dumps(np.round(ground.vertices, 12).tolist()),
         "equilibrium": json.dumps(eq.summary()),
-        "arm_pivots": json.dumps(model.arms[:, :2].tolist()),
+        "arm_pivots": json.dumps(model.arms[:, [L.ARMS_PX, L.ARMS_PY]].tolist()),
         "track_ends": json.dumps(model.ends.tolist()),
         "wheel_radius": float(model.par[L.P_WHEEL_RADIUS]),
-        "arm_length": float(la),
+        "arm_length": float(model.par[L.P_ARM_LENGTH]),
         "pad_wheel": float(model.par[L.P_PAD_WHEEL]),
         "pad_ground": float(model.par[L.P_PAD_GROUND]),
     }
+
+
+def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solve_time):
+    """The Dataset of one run. Solvers hand over arrays; solver-specific ones come in
+    result.extra as (dims, data, units, long_name)."""
+    nw, nl = model.nw, model.n_links
+    v = _motion(model, result)
+    v.update(_energies(result, L.n_coordinates(nw, nl)))
+    v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
+    for name, (dims, data, units, text) in result.extra.items():
+        v[name] = _var(dims, data, units, text)
+    coords = {
+        "time": _var(T, result.time, "s", "simulated time"),
+        "wheel": _var(("wheel",), np.arange(1, nw + 1), "1", "road wheel number, 1 = front"),
+        "pin": _var(("pin",), np.arange(nl + 1), "1", "track pin number, 0 = front track end"),
+        "link": _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1)"),
+    }
+    attrs = _attrs(scenario, model, eq, ground, resolved, result.stats, wall_time, solve_time)
     return xr.Dataset(v, coords=coords, attrs=attrs)
 
 

@@ -4,10 +4,11 @@ place the wheels and pins through these functions, so they agree to the last bit
 
 import math
 
+import numpy as np
 from numba import njit
 
-from .bundles import ARM_COS, ARM_SIN
-from .jit import INLINE
+from .bundles import ARM_COLS, ARM_COS, ARM_SIN
+from .jit import INLINE, KERNEL
 from .layout import P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y, q_pin
 
 
@@ -79,3 +80,11 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
         avel[b, 0] = qd[k]
         avel[b, 1] = qd[k + 1]
     return c, s
+
+
+@njit(**KERNEL)
+def place_samples(qs, par, arms, ends, pins, wheels):
+    """place() for every row of qs (output samples): pins (n, n_pins, 2), wheels (n, n_wheels, 2)."""
+    arm = np.empty((arms.shape[0], ARM_COLS))
+    for k in range(qs.shape[0]):
+        place(qs[k], par, arms, ends, pins[k], wheels[k], arm)

@@ -270,6 +270,26 @@ def _log_signals(rec, ds):
     rec.send_columns(E_TENSION, indexes=t, columns=scalars(np.nanmax(ds.variables["link_tension"].values, axis=1)))
 
 
+def _log_track(rec, t, take, n):
+    """Pins and links (coloured by tension) at the frames; returns the pins' x and y."""
+    send = rec.send_columns
+    pin_x, pin_y = take("pin_x"), take("pin_y")
+    pins = _xy32(pin_x, pin_y)                                    # (n, np, 2)
+    npin = pins.shape[1]
+    nl = npin - 1
+    send(E_PINS, indexes=t, columns=[_Column(rr.Points2D.descriptor_positions(), _list(_vec2(pins), n, npin))])
+    p64 = pins.view(np.uint64)[..., 0]                           # one (x, y) float32 pair as 8 bytes
+    links64 = np.empty((n, nl, 2), dtype=np.uint64)
+    links64[:, :, 0] = p64[:, :-1]
+    links64[:, :, 1] = p64[:, 1:]
+    links = links64.view(np.float32)                              # (n, nl, 4): the link's two ends
+    colors = G.tension_rgba32(take("link_tension"))
+    send(E_LINKS, indexes=t,
+         columns=[_Column(rr.LineStrips2D.descriptor_strips(), _list(_strip_values(links.reshape(n * nl, 2, 2)), n, nl)),
+                  _Column(rr.LineStrips2D.descriptor_colors(), _list(pa.array(colors.reshape(-1), type=_COLOR_TYPE), n, nl))])
+    return pin_x, pin_y
+
+
 def _log_frames(rec, ds, idx):
     """The side view at the frames `idx`: the same geometry as geometry.side_view, computed
     straight into float32 (y negated) buffers and Arrow arrays, one send_columns per entity.
@@ -285,22 +305,7 @@ def _log_frames(rec, ds, idx):
 
     t = [rr.TimeColumn(TIMELINE, duration=take("time"))]
     send = rec.send_columns
-
-    # track: pins, links (coloured by tension)
-    pin_x, pin_y = take("pin_x"), take("pin_y")
-    pins = _xy32(pin_x, pin_y)                                    # (n, np, 2)
-    npin = pins.shape[1]
-    nl = npin - 1
-    send(E_PINS, indexes=t, columns=[_Column(rr.Points2D.descriptor_positions(), _list(_vec2(pins), n, npin))])
-    p64 = pins.view(np.uint64)[..., 0]                           # one (x, y) float32 pair as 8 bytes
-    links64 = np.empty((n, nl, 2), dtype=np.uint64)
-    links64[:, :, 0] = p64[:, :-1]
-    links64[:, :, 1] = p64[:, 1:]
-    links = links64.view(np.float32)                              # (n, nl, 4): the link's two ends
-    colors = G.tension_rgba32(take("link_tension"))
-    send(E_LINKS, indexes=t,
-         columns=[_Column(rr.LineStrips2D.descriptor_strips(), _list(_strip_values(links.reshape(n * nl, 2, 2)), n, nl)),
-                  _Column(rr.LineStrips2D.descriptor_colors(), _list(pa.array(colors.reshape(-1), type=_COLOR_TYPE), n, nl))])
+    pin_x, pin_y = _log_track(rec, t, take, n)
 
     # chassis outline, arms (pivot to wheel centre), wheel-track force arrows (from the
     # contact region along the force), ground force (total) at the pad-compression-weighted

@@ -3,12 +3,10 @@ multipliers by Lee's accelerated iteration, the Dormand-Prince RKN6(4) pair. Tak
 returns the reduced layout so every output means the same as for the reduced solver;
 solver-specific figures go to RunResult.extra (results_schema.md, lee section)."""
 
-import numpy as np
 
 from ..model import layout as L
 from ..model.absolute import inverse_mass
 from ..model.bundles import event_arrays
-from ..output import _var
 from .base import allocate_outputs, control, trimmed
 from .lee_loop import integrate_lee
 from .lee_work import (L_BUILDS, L_DIAG_UNCONVERGED, L_EPS1, L_IT_ACC, L_IT_DIAG, L_IT_OUT, L_IT_POS, L_IT_VEL,
@@ -50,10 +48,10 @@ def run(scenario, model, y0):
     n = int(out.stats[L.S_N_OUT])
     out_x, out_lam, lstats = lout
     T, W = ("time",), ("time", "wheel")
-    extra = {name: _var(T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
-    extra["joint_force_x"] = _var(W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
+    extra = {name: (T, out_x[:n, col], units, text) for name, col, units, text in _PER_SAMPLE}
+    extra["joint_force_x"] = (W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
-    extra["joint_force_y"] = _var(W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
+    extra["joint_force_y"] = (W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
     totals = [
         ("lee_total_iterations_position", L_IT_POS, "1", "lambda iterations at the position level, whole run "
@@ -78,6 +76,6 @@ def run(scenario, model, y0):
                                                                "/ tolerance"),
     ]
     for name, k, units, text in totals:
-        extra[name] = _var((), lstats[k], units, text)
-    extra["lee_accel_order"] = _var((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
+        extra[name] = ((), lstats[k], units, text)
+    extra["lee_accel_order"] = ((), scenario["lee.accel_order"], "1", "n of the accelerated iteration (A1-A6)")
     return trimmed(scenario, out, extra)

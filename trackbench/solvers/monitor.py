@@ -4,6 +4,7 @@ between output samples is missed."""
 import numpy as np
 from numba import njit
 
+from ..model.energy import paper_balance, work_residual
 from ..model.jit import INLINE, KERNEL
 
 from ..model.layout import (
@@ -29,14 +30,14 @@ _SIGNS = (1.0, 1.0, -1.0, 1.0, -1.0)
 @njit(**KERNEL)
 def energy_balance(diag):
     """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
-    return (diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_PAD_WHEEL]
-            + diag[D_E_PAD_GROUND] + diag[D_E_GRAVITY])
+    return paper_balance(diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_TENSION], diag[D_E_PAD_WHEEL],
+                         diag[D_E_PAD_GROUND], diag[D_E_GRAVITY])
 
 
 @njit(**KERNEL)
 def energy_residual(diag, work):
     """Kinetic + torsion + tension + gravity - work of the contact forces (continuous)."""
-    return diag[D_E_KINETIC] + diag[D_E_TORSION] + diag[D_E_TENSION] + diag[D_E_GRAVITY] - work
+    return work_residual(diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_TENSION], diag[D_E_GRAVITY], work)
 
 
 @njit(**KERNEL)
