@@ -73,14 +73,13 @@ def execute_run(task):
     rec = {"run_id": task["run_id"], **task["meta"], "status": "failed", "status_message": "",
            "started": _now(), "started_unix": time.time(), "host": socket.gethostname(), "pid": os.getpid(),
            "attempt": task.get("attempt", 1), "attempt_id": task.get("attempt_id")}
-    reason = folder_problem(output)
-    if reason is None:
-        try:  # runs/<id> only: the study folder itself exists (checked), a worker never creates it
-            rdir.mkdir(parents=True, exist_ok=True)
-        except OSError as e:
-            reason = _fail(rec, e, rdir)
-    if reason is not None:
-        rec["status_message"] = rec["status_message"] or reason
+    rec["status_message"] = folder_problem(output) or ""
+    if rec["status_message"]:
+        return _finish(rec, task, t0, rdir=None)
+    try:  # runs/<id> only: the study folder itself exists (checked), a worker never creates it
+        rdir.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        _fail(rec, e, rdir)
         return _finish(rec, task, t0, rdir=None)
     ds = _simulate(task, rec)
     if ds is not None:
@@ -93,7 +92,8 @@ def folder_problem(output):
     names the folder and this host, since a worker elsewhere may not see the coordinator's files."""
     host = socket.gethostname()
     if not output.is_absolute():
-        return f"the study folder {output} is not an absolute path (host {host}): it would be read against the worker's working directory"
+        return (f"the study folder {output} is not an absolute path (host {host}): it would be taken "
+                "against the worker's working directory")
     if not output.is_dir():
         return (f"the study folder {output} does not exist on worker host {host}: every worker must see "
                 "the study folder at the same path (a shared file system)")
@@ -109,11 +109,11 @@ def failure_reason(exc, folder, need_bytes=None):
     """A reason a user can act on for ``exc`` raised while working in ``folder``: a full disk
     (with the folder's free space), permission denied, a missing path; else the exception
     itself. netCDF/HDF5 report a full disk as "NetCDF: HDF error" (no errno, or netCDF's own
-    negative code): when writing
-    ``need_bytes`` failed, free space below that (plus 1 MiB of slack) is taken as a full disk."""
+    negative code): when writing ``need_bytes`` failed that way, free space below that (plus
+    1 MiB of slack) is taken as a full disk."""
     host = socket.gethostname()
     err = getattr(exc, "errno", None)
-    where = getattr(exc, "filename", None) or folder
+    where = os.fsdecode(getattr(exc, "filename", None) or folder)
     if err in (errno.EACCES, errno.EPERM):
         return f"permission denied: {where} (host {host}, uid {os.getuid()})"
     if err == errno.EROFS:
@@ -124,8 +124,8 @@ def failure_reason(exc, folder, need_bytes=None):
     if err in (errno.ENOSPC, errno.EDQUOT) or (
             (err is None or err < 0) and need_bytes is not None and free is not None and free < need_bytes + 2**20):
         size = f", the run writes about {need_bytes / 1e6:.2f} MB" if need_bytes else ""
-        room = "unknown space" if free is None else f"{free / 1e6:.2f} MB"
-        return f"no space left on the device holding {folder} (host {host}): {room} free{size}"
+        room = "free space unknown" if free is None else f"{free / 1e6:.2f} MB free"
+        return f"no space left on the device holding {folder} (host {host}): {room}{size}"
     return f"{type(exc).__name__}: {exc}"
 
 
@@ -142,10 +142,8 @@ def _free_bytes(folder):
 
 def _fail(rec, exc, folder, need_bytes=None):
     """Mark ``rec`` failed by ``exc``: the readable reason, the original exception, the traceback."""
-    reason = failure_reason(exc, folder, need_bytes)
-    rec.update(status="failed", status_message=reason, exception=f"{type(exc).__name__}: {exc}",
-               traceback=traceback.format_exc(limit=8))
-    return reason
+    rec.update(status="failed", status_message=failure_reason(exc, folder, need_bytes),
+               exception=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc(limit=8))
 
 
 def _simulate(task, rec):
