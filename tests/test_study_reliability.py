@@ -267,7 +267,8 @@ def test_killed_dask_worker_run_rescheduled_once_counted_bit_for_bit(tmp_path, r
         while killed is None and not stop.is_set() and time.time() < deadline:
             for w, keys in c.processing().items():
                 rids = [str(k).removeprefix("trackbench-run-") for k in keys]
-                mid_run = [r for r in rids if (out / "runs" / r).is_dir() and not (out / "runs" / r / "run.json").exists()]
+                mid_run = [r for r in rids if (out / "runs" / r).is_dir()
+                           and not (out / "runs" / r / "run.json").exists()]
                 if mid_run:
                     os.kill(pids[w], signal.SIGKILL)
                     killed = (mid_run[0], pids[w])
@@ -378,7 +379,8 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
     monkeypatch.setattr(executors.shutil, "disk_usage", lambda p: Usage(10**9, 10**9, 0))
     rec = executors.execute_run(task)
     assert rec["status"] == "failed" and rec["exception"] == "RuntimeError: NetCDF: HDF error"
-    assert rec["status_message"].startswith(f"no space left on the device holding {store.run_dir(s.output, run.run_id)}")
+    rdir = store.run_dir(s.output, run.run_id)
+    assert rec["status_message"].startswith(f"no space left on the device holding {rdir}")
     assert "0.00 MB free, the run writes about 0.0" in rec["status_message"]
     assert store.read_run(s.output, run.run_id)["exception"] == "RuntimeError: NetCDF: HDF error"
 
