@@ -252,6 +252,7 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "trackbench.replay.record", mod)
     s = load_study(_write(tmp_path, "[scenario]\nduration = 0.02\noutput_interval = 0.001\n"), output=tmp_path / "o")
     run = s.runs[0]
+    store.write_json(s.output / "runs.json", {})  # a worker writes only into an existing study folder
     task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}}
     rec = execute_run(task)
     assert rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]

@@ -75,9 +75,8 @@ def study_run(
     except KeyboardInterrupt:
         _fail("interrupted: completed runs are kept; run the same command again to finish the study", code=130)
     typer.echo(report(outcome))
-    if outcome.failed_total:
-        _fail(f"{outcome.failed_total} of {len(outcome.study.runs)} runs failed (reasons in the summary and "
-              "in runs/<run-id>/run.json)", code=1)
+    if outcome.problem():
+        _fail(outcome.problem(), code=1)
 
 
 @study_app.command("summary")

@@ -2,12 +2,17 @@
 
 Tasks and results are plain dicts (picklable, no Scenario objects)."""
 
+import errno
 import math
 import os
+import shutil
 import socket
 import time
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import uuid
+from collections import deque
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -58,48 +63,152 @@ def _record(ds, rdir, scenario):
 def execute_run(task):
     """Run one study run in this process and write its folder; returns the run.json dict.
 
-    task: run_id, output, scenario (resolved dict), meta (study, variant, replicate, params),
-    compress. Never raises for a failing run: the failure is the record."""
+    task: run_id, output (absolute: the study folder as every worker sees it), scenario
+    (resolved dict), meta (study, variant, replicate, params), compress, attempt, attempt_id.
+    Never raises for a failing run: the failure is the record (its reason in status_message,
+    the original exception in exception)."""
     t0 = time.perf_counter()
-    rdir = store.run_dir(task["output"], task["run_id"])
-    rdir.mkdir(parents=True, exist_ok=True)
+    output = Path(task["output"])
+    rdir = store.run_dir(output, task["run_id"])
     rec = {"run_id": task["run_id"], **task["meta"], "status": "failed", "status_message": "",
-           "started": _now(), "started_unix": time.time(), "host": socket.gethostname(), "pid": os.getpid()}
+           "started": _now(), "started_unix": time.time(), "host": socket.gethostname(), "pid": os.getpid(),
+           "attempt": task.get("attempt", 1), "attempt_id": task.get("attempt_id")}
+    rec["status_message"] = folder_problem(output) or ""
+    if rec["status_message"]:
+        return _finish(rec, task, t0, rdir=None)
+    try:  # runs/<id> only: the study folder itself exists (checked), a worker never creates it
+        rdir.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        _fail(rec, e, rdir)
+        return _finish(rec, task, t0, rdir=None)
+    ds = _simulate(task, rec)
+    if ds is not None:
+        _write(ds, rdir, task, rec)
+    return _finish(rec, task, t0, rdir)
+
+
+def folder_problem(output):
+    """Why this worker cannot use the study folder ``output`` (None when it can): the reason
+    names the folder and this host, since a worker elsewhere may not see the coordinator's files."""
+    host = socket.gethostname()
+    if not output.is_absolute():
+        return (f"the study folder {output} is not an absolute path (host {host}): it would be taken "
+                "against the worker's working directory")
+    if not output.is_dir():
+        return (f"the study folder {output} does not exist on worker host {host}: every worker must see "
+                "the study folder at the same path (a shared file system)")
+    if not (output / "runs.json").is_file():
+        return (f"the folder {output} on worker host {host} is not the study's (no runs.json): every worker "
+                "must see the study folder at the same path (a shared file system)")
+    if not os.access(output, os.W_OK | os.X_OK):
+        return f"permission denied: worker host {host} (uid {os.getuid()}) cannot write to the study folder {output}"
+    return None
+
+
+def failure_reason(exc, folder, need_bytes=None):
+    """A reason a user can act on for ``exc`` raised while working in ``folder``: a full disk
+    (with the folder's free space), permission denied, a missing path; else the exception
+    itself. netCDF/HDF5 report a full disk as "NetCDF: HDF error" (no errno, or netCDF's own
+    negative code): when writing ``need_bytes`` failed that way, free space below that (plus
+    1 MiB of slack) is taken as a full disk."""
+    host = socket.gethostname()
+    err = getattr(exc, "errno", None)
+    where = os.fsdecode(getattr(exc, "filename", None) or folder)
+    if err in (errno.EACCES, errno.EPERM):
+        return f"permission denied: {where} (host {host}, uid {os.getuid()})"
+    if err == errno.EROFS:
+        return f"read-only file system: {where} (host {host})"
+    if err == errno.ENOENT:
+        return f"{where} does not exist on host {host}"
+    free = _free_bytes(folder)
+    if err in (errno.ENOSPC, errno.EDQUOT) or (
+            (err is None or err < 0) and need_bytes is not None and free is not None and free < need_bytes + 2**20):
+        size = f", the run writes about {need_bytes / 1e6:.2f} MB" if need_bytes else ""
+        room = "free space unknown" if free is None else f"{free / 1e6:.2f} MB free"
+        return f"no space left on the device holding {folder} (host {host}): {room}{size}"
+    return f"{type(exc).__name__}: {exc}"
+
+
+def _free_bytes(folder):
+    """Free bytes on the file system of ``folder`` (its nearest existing parent), or None."""
+    p = Path(folder)
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    try:
+        return shutil.disk_usage(p).free
+    except OSError:
+        return None
+
+
+def _fail(rec, exc, folder, need_bytes=None):
+    """Mark ``rec`` failed by ``exc``: the readable reason, the original exception, the traceback."""
+    rec.update(status="failed", status_message=failure_reason(exc, folder, need_bytes),
+               exception=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc(limit=8))
+
+
+def _simulate(task, rec):
+    """The run's Dataset, or None (``rec`` failed) when the scenario or the solver raised."""
     try:
         from .. import __version__
         from ..output import MODEL_VERSION
         from ..scenario import Scenario
         from ..simulate import simulate
         rec.update(model_version=MODEL_VERSION, trackbench_version=__version__)
-        sc = Scenario.from_dict({}, base=task["scenario"])
-        ds = simulate(sc)
-        store.write_timeseries(ds, rdir / "timeseries.nc", compress=task.get("compress", False))
-        a = ds.attrs
-        msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
-        rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
-                   rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-                   timeseries="timeseries.nc", results=results_of(ds))
-        rec["recording"], err = _record(ds, rdir, task["scenario"])
-        if err:
-            rec["recording_error"] = err
+        return simulate(Scenario.from_dict({}, base=task["scenario"]))
     except Exception as e:
         rec.update(status="failed", status_message=f"{type(e).__name__}: {e}",
-                   traceback=traceback.format_exc(limit=8))
+                   exception=f"{type(e).__name__}: {e}", traceback=traceback.format_exc(limit=8))
+        return None
+
+
+def _write(ds, rdir, task, rec):
+    """timeseries.nc (and the recording) of a finished simulation; the solver's verdict in ``rec``."""
+    try:
+        store.write_timeseries(ds, rdir / "timeseries.nc", compress=task.get("compress", False))
+    except Exception as e:
+        _fail(rec, e, rdir, need_bytes=ds.nbytes)
+        return
+    a = ds.attrs
+    msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
+    rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
+               rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
+               timeseries="timeseries.nc", results=results_of(ds))
+    rec["recording"], err = _record(ds, rdir, task["scenario"])
+    if err:
+        rec["recording_error"] = err
+
+
+def _finish(rec, task, t0, rdir):
+    """Times and scenario into ``rec``; run.json written last (when ``rdir`` is usable). A run
+    whose run.json cannot be written is failed, and its timeseries.nc removed: nothing is left
+    that looks like a result."""
     rec["finished"] = _now()
     rec["finished_unix"] = time.time()
     rec["wall_time"] = time.perf_counter() - t0
     rec["scenario"] = task["scenario"]
-    store.write_json(rdir / "run.json", rec)
+    if rdir is None:
+        return rec
+    try:
+        store.write_json(rdir / "run.json", rec)
+    except Exception as e:
+        why = failure_reason(e, rdir)
+        rec.update(status="failed", status_message=f"run.json could not be written: {why}",
+                   exception=f"{type(e).__name__}: {e}")
+        try:
+            (rdir / "timeseries.nc").unlink(missing_ok=True)
+        except OSError:
+            pass
     return rec
 
 
-def crashed(task, exc):
-    """The record of a run whose worker died or could not be reached; written to run.json."""
-    rec = {"run_id": task["run_id"], **task["meta"], "status": "failed",
-           "status_message": f"the worker running it died or failed: {type(exc).__name__}: {exc}",
-           "finished": _now(), "scenario": task["scenario"]}
-    store.write_json(store.run_dir(task["output"], task["run_id"]) / "run.json", rec)
-    return rec
+def crashed(task, exc, tries=None):
+    """The record of a run whose worker died or could not be reached (the coordinator writes it)."""
+    times = f" ({tries} times)" if tries and tries > 1 else ""
+    return {"run_id": task["run_id"], **task["meta"], "status": "failed",
+            "status_message": f"the worker process running it died or could not be reached{times}: "
+                              f"{type(exc).__name__}: {exc}",
+            "exception": f"{type(exc).__name__}: {exc}", "attempt": tries or task.get("attempt", 1),
+            "attempt_id": task.get("attempt_id"), "finished": _now(), "scenario": task["scenario"]}
 
 
 def _warm():
@@ -124,32 +233,90 @@ def _warm():
         pass
 
 
-def run_local(tasks, workers=2):
-    """Yield (task, record) as runs finish, on a spawn-context process pool."""
+MAX_ATTEMPTS = 3  # tries of a run whose worker process died (dask: allowed-failures + 1)
+
+
+def _attempt(task, number):
+    """The task for try ``number``: a fresh attempt_id lets the coordinator tell this try's
+    run.json from an older one (a --force rerun, an earlier try)."""
+    return {**task, "attempt": number, "attempt_id": uuid.uuid4().hex}
+
+
+def _new_pool(workers):
     import multiprocessing
     ctx = multiprocessing.get_context("spawn")
     # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
     # threads spin (seen at ~6 % of a core per worker); spawned children inherit this
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm) as pool:
-        futures = {pool.submit(execute_run, t): t for t in tasks}
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm)
+
+
+def _next_task(fresh, retry, running):
+    """A run tried before goes beside fresh runs only: a run that kills its worker then cannot
+    use up the tries of the runs that happened to run next to it."""
+    if retry and not any(t["attempt"] > 1 for t in running.values()):
+        return retry.popleft()
+    return fresh.popleft() if fresh else None
+
+
+def run_local(tasks, workers=2, notify=None):
+    """Yield (task, record) as runs finish, on a spawn-context process pool.
+
+    No more runs are submitted than there are workers, so the runs in flight are known: a
+    worker that dies (killed, out of memory) breaks the pool (BrokenProcessPool); the pool is
+    started again and the runs that were in flight are tried again, each at most MAX_ATTEMPTS
+    times, and yielded once. ``notify(text)`` hears about the restarts."""
+    fresh, retry, running, pool = deque(_attempt(t, 1) for t in tasks), deque(), {}, None
+    try:
+        while fresh or retry or running:
+            pool = pool or _new_pool(workers)
+            broken = _fill(pool, fresh, retry, running, workers)
+            if not broken:
+                wait(list(running), return_when=FIRST_COMPLETED)
+                broken = any(f.done() and not f.cancelled() and isinstance(f.exception(), BrokenProcessPool)
+                             for f in running)
+            if broken:  # every future of the pool ends now: shut it down, then sort them
+                pool.shutdown(wait=True, cancel_futures=True)
+                pool = None
+            for fut in [f for f in running if f.done()]:
+                task = running.pop(fut)
+                if fut.cancelled():  # never started: back in line, no try spent
+                    (retry if task["attempt"] > 1 else fresh).appendleft(task)
+                    continue
+                exc = fut.exception()
+                if isinstance(exc, BrokenProcessPool) and task["attempt"] < MAX_ATTEMPTS:
+                    retry.append(_attempt(task, task["attempt"] + 1))
+                    if notify:
+                        notify(f"a worker process died; run {task['run_id']} is tried again "
+                               f"(try {task['attempt'] + 1} of {MAX_ATTEMPTS})")
+                else:
+                    yield task, (crashed(task, exc, task["attempt"]) if exc else fut.result())
+    finally:
+        if pool is not None:
+            pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _fill(pool, fresh, retry, running, workers):
+    """Submit runs up to one per worker; True when the pool turned out to be broken."""
+    while len(running) < workers:
+        task = _next_task(fresh, retry, running)
+        if task is None:
+            return False
         try:
-            for fut in as_completed(futures):
-                task = futures[fut]
-                try:
-                    yield task, fut.result()
-                except Exception as e:  # BrokenProcessPool, pickling errors
-                    yield task, crashed(task, e)
-        except BaseException:
-            for f in futures:
-                f.cancel()
-            raise
+            running[pool.submit(execute_run, task)] = task
+        except BrokenProcessPool:  # a worker died while idle: the run never started
+            (retry if task["attempt"] > 1 else fresh).appendleft(task)
+            return True
+    return False
 
 
-def run_dask(tasks, workers=2, scheduler=None):
+def run_dask(tasks, workers=2, scheduler=None, notify=None):
     """Yield (task, record) as runs finish, on a dask.distributed cluster (a LocalCluster of
-    ``workers`` processes when no scheduler address is given)."""
+    ``workers`` processes when no scheduler address is given). A worker that dies is dask's to
+    handle: the scheduler runs its task elsewhere, up to its allowed-failures (set to
+    MAX_ATTEMPTS - 1 on a LocalCluster), then the future raises KilledWorker."""
+    import dask
     from dask.distributed import Client, LocalCluster
     from dask.distributed import as_completed as dask_completed
     cluster = None
@@ -159,12 +326,14 @@ def run_dask(tasks, workers=2, scheduler=None):
         except (OSError, TimeoutError) as e:
             raise RuntimeError(f"cannot reach the dask scheduler at {scheduler}: {e}") from None
     else:
-        cluster = LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
-                               dashboard_address=None)
+        with dask.config.set({"distributed.scheduler.allowed-failures": MAX_ATTEMPTS - 1}):
+            cluster = LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
+                                   dashboard_address=None)
         client = Client(cluster)
     try:
         futures = {}
         for t in tasks:
+            t = _attempt(t, 1)
             futures[client.submit(execute_run, t, pure=False, key=f"trackbench-run-{t['run_id']}")] = t
         for fut in dask_completed(list(futures)):
             task = futures[fut]

@@ -3,13 +3,16 @@
     outcome = run_study("studies/speed_sweep.toml", workers=2)
 """
 
+import os
+import socket
 import sys
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from . import executors, store
 from .spec import load_study, resolved_toml
-from .summary import format_table, summary_frame, write_summary
+from .summary import format_table, replicate_frame, summary_frame, write_summary
 
 
 @dataclass
@@ -21,10 +24,34 @@ class Outcome:
     summary: object = None                          # DataFrame
     replicates: object = None                       # DataFrame or None
     elapsed: float = 0.0
+    summary_error: str = ""                         # why summary.csv could not be written
+
+    def counts(self):
+        """(failed, not run) over the study's runs: the summary's view, plus the runs failed in
+        this invocation whose record could not be written."""
+        if self.summary is None:
+            return len(self.failed), 0
+        status = dict(zip(self.summary.run_id, self.summary.status))
+        status.update({rid: "failed" for rid in self.failed})
+        failed = sum(s == "failed" for s in status.values())
+        return failed, sum(s not in ("completed", "failed") for s in status.values())
 
     @property
     def failed_total(self):
-        return int((self.summary.status == "failed").sum()) if self.summary is not None else len(self.failed)
+        return self.counts()[0]
+
+    def problem(self):
+        """None when every run of the study is completed and recorded; otherwise the one line
+        that goes with a nonzero exit, saying how many runs are not completed."""
+        failed, missing = self.counts()
+        n = len(self.study.runs)
+        parts = ([f"{failed} of {n} runs failed"] if failed else []) + (
+            [f"{missing} of {n} runs not run"] if missing else [])
+        if self.summary_error:
+            parts.append(f"the summary could not be written: {self.summary_error}")
+        if not parts:
+            return None
+        return ", ".join(parts) + " (reasons in the summary and in runs/<run-id>/run.json)"
 
 
 def manifest(study):
@@ -86,6 +113,10 @@ class _Progress:
             self.console.print(f"[{n}/{self.total}] {rec['run_id']} {rec['status']}{msg}  ({self._counts()}, "
                                f"ETA {eta:.0f} s)", highlight=False, markup=False)
 
+    def note(self, text):
+        if not self.quiet:
+            self.console.print(text, highlight=False, markup=False)
+
     def close(self):
         if self.bar is not None:
             self.bar.stop()
@@ -99,6 +130,8 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
     executors.check_executor(executor, scheduler)
     study = load_study(path, output=output)
+    # workers get absolute paths only: a relative one would land in each worker's own cwd
+    study.output = Path(os.path.abspath(study.output))
     out = Outcome(study=study)
     t0 = time.perf_counter()
     with store.study_lock(study.output):
@@ -111,12 +144,13 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         out.skipped = len(done)
         progress = _Progress(len(tasks), len(done), quiet)
         if executor == "dask":
-            stream = executors.run_dask(tasks, workers, scheduler)
+            stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
         else:
-            stream = executors.run_local(tasks, workers)
+            stream = executors.run_local(tasks, workers, notify=progress.note)
         try:
             if tasks:
                 for task, rec in stream:
+                    rec = confirm(task, rec)
                     out.ran += 1
                     if rec["status"] != "completed":
                         out.failed.append(task["run_id"])
@@ -124,9 +158,70 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         finally:
             stream.close()
             progress.close()
-            out.summary, out.replicates = write_summary(study)
+            store.clean_tmp(study.output)  # what killed workers left half-written
+            _summarise(study, out)
     out.elapsed = time.perf_counter() - t0
     return out
+
+
+def _summarise(study, out):
+    """Write the summary files; when they cannot be written the frames are still returned and
+    the reason kept (the study then does not count as done)."""
+    try:
+        out.summary, out.replicates = write_summary(study)
+    except OSError as e:
+        out.summary_error = executors.failure_reason(e, study.output)
+        out.summary = summary_frame(study)
+        out.replicates = replicate_frame(study, out.summary) if study.replicates > 1 else None
+
+
+def confirm(task, rec):
+    """The coordinator's verdict on a run a worker returned: completed only when the study
+    folder as this process sees it holds the run (run.json of this try saying completed and
+    a timeseries.nc that opens); otherwise failed with the reason. Any verdict that is not
+    already on disk as the worker's own record is written to run.json here."""
+    rdir = store.run_dir(task["output"], task["run_id"])
+    disk = store.read_json(rdir / "run.json")
+    own = disk is not None and rec.get("attempt_id") is not None and disk.get("attempt_id") == rec["attempt_id"]
+    if rec["status"] == "completed":
+        reason = _files_problem(rdir, disk, own, rec)
+        if reason is None:
+            return rec
+        rec = {**rec, "status": "failed", "status_message": reason, "worker_status": "completed"}
+    elif own and disk.get("status") == rec["status"]:
+        return rec
+    try:
+        store.write_json(rdir / "run.json", rec)
+    except OSError as e:
+        rec = {**rec, "status_message": f"{rec['status_message']}; not recorded in {rdir}: "
+                                        f"{executors.failure_reason(e, rdir)}"}
+    return rec
+
+
+def _files_problem(rdir, disk, own, rec):
+    """Why a run a worker reports completed is not completed here (None when it is). An
+    unreadable timeseries.nc is removed: it must not look like a result."""
+    here = socket.gethostname()
+    said = f"the worker on host {rec.get('host', '?')} reported the run completed, but"
+    shared = "do the workers see the study folder at the same path (a shared file system)?"
+    if disk is None:
+        return f"{said} {rdir / 'run.json'} is missing or unreadable on host {here}: {shared}"
+    if not own:
+        return f"{said} {rdir / 'run.json'} on host {here} is not the record it wrote: {shared}"
+    if disk.get("status") != "completed":
+        return f"{said} {rdir / 'run.json'} on host {here} says {disk.get('status')!r}"
+    nc = rdir / "timeseries.nc"
+    try:
+        import netCDF4
+        with netCDF4.Dataset(nc, "r") as f:
+            f.getncattr("status")
+    except Exception as e:
+        try:
+            nc.unlink(missing_ok=True)
+        except OSError:
+            pass
+        return f"{said} {nc} cannot be read on host {here}: {type(e).__name__}: {e}"
+    return None
 
 
 def status_counts(study):
@@ -139,7 +234,10 @@ def report(outcome):
     """The text printed after a study run."""
     s = outcome.study
     text = format_table(outcome.summary, outcome.replicates, s.param_names)
-    n_failed = outcome.failed_total
+    n_failed, n_missing = outcome.counts()
+    missing = f", {n_missing} not run" if n_missing else ""
     text += (f"\n\nstudy {s.name}: {len(s.runs)} runs, {outcome.ran} run now, {outcome.skipped} already completed, "
-             f"{n_failed} failed; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
+             f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
+    if outcome.summary_error:
+        text += f" NOT WRITTEN: {outcome.summary_error}"
     return text
