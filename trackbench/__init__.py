@@ -1,13 +1,28 @@
 """trackbench: dynamics of high-mobility tracked vehicles (K. Lee, KSME Int. J., 2000)."""
 
-__version__ = "0.1.0"
-
-from . import _jitcache  # noqa: E402
+from . import _jitcache
+from .version import __version__
 
 _jitcache.configure()  # before any compiled kernel is defined
 
-from .scenario import Scenario, ScenarioError  # noqa: E402
-from .simulate import simulate  # noqa: E402
-from .study.summary import open_study, open_study_dataset  # noqa: E402
+# the heavy parts (numba, xarray, pandas) load on first use: the command line's help and
+# the validation of scenarios and study files stay fast
+_LAZY = {
+    "Scenario": ("scenario", "Scenario"),
+    "ScenarioError": ("scenario", "ScenarioError"),
+    "simulate": ("simulate", "simulate"),
+    "open_study": ("study.summary", "open_study"),
+    "open_study_dataset": ("study.summary", "open_study_dataset"),
+}
 
 __all__ = ["Scenario", "ScenarioError", "simulate", "open_study", "open_study_dataset", "__version__"]
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'trackbench' has no attribute {name!r}")
+    import importlib
+    module, attr = _LAZY[name]
+    value = getattr(importlib.import_module(f".{module}", __name__), attr)
+    globals()[name] = value
+    return value

@@ -11,6 +11,7 @@ few folders are kept. Setting NUMBA_CACHE_DIR yourself overrides this.
 import hashlib
 import os
 import shutil
+import sys
 from pathlib import Path
 
 KEEP = 3
@@ -39,5 +40,5 @@ def configure():
     except OSError:
         return  # not writable: numba falls back to __pycache__ / its own rules
     os.environ["NUMBA_CACHE_DIR"] = str(target)
-    import numba  # noqa: E402  (numba may already be imported: set its live config too)
-    numba.config.CACHE_DIR = str(target)
+    if "numba" in sys.modules:  # already imported (by the user): set its live config too
+        sys.modules["numba"].config.CACHE_DIR = str(target)

@@ -43,7 +43,7 @@ def params():
     typer.echo(parameter_table())
 
 
-# --- study commands (issue 4) -------------------------------------------------------
+# --- study commands ----------------------------------------------------------------
 
 def _load_study_or_fail(file: Path):
     from .study import StudyError, load_study
@@ -62,6 +62,7 @@ def study_run(
     force: bool = typer.Option(False, "--force", help="Rerun every run, also those already completed."),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
+    _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:

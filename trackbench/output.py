@@ -9,13 +9,12 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import __version__
+from .version import MODEL_VERSION, __version__
 from .model import layout as L
 from .model.energy import paper_balance, work_residual
 from .model.kinematics import place_samples
 from .status import Result
 
-MODEL_VERSION = "1"  # bump when a change to the model or solvers changes results
 
 
 def _var(dims, data, units, long_name, **attrs):

@@ -3,7 +3,6 @@
 import tomllib
 from pathlib import Path
 
-from .output import summary_numbers, write_netcdf
 from .scenario import RULES, Scenario, ScenarioError, flatten, paper_step
 
 
@@ -32,6 +31,7 @@ def _time(t, digits):
 
 
 def format_summary(ds, path=None):
+    from .output import summary_numbers
     s = summary_numbers(ds)
     lines = [f"trackbench run '{ds.attrs['title'].split(': ', 1)[-1]}': {ds.attrs['status']}"
              + ("" if ds.attrs["status"] == "completed" else f" at t = {ds.attrs['t_final']:.6g} s: {ds.attrs['status_message']}")]
@@ -57,10 +57,11 @@ def run_one(sets, duration, out, name, force=False):
     """Run, write OUT/NAME.nc (+ NAME.rrd); a failed run is kept for diagnosis as
     NAME.failed.nc, never under the name of a complete result. Existing files of that
     name are only replaced with force. Returns (text, ok)."""
+    sc = scenario_from_sets(sets, duration)   # bad input fails here, before the solver libraries load
+    sc = sc.with_overrides({"name": name})
+    from .output import write_netcdf
     from .replay.record import maybe_write_recording
     from .simulate import simulate
-    sc = scenario_from_sets(sets, duration)
-    sc = sc.with_overrides({"name": name})
     targets = [Path(out) / f"{name}{ext}" for ext in (".nc", ".rrd", ".failed.nc")]
     existing = [p for p in targets if p.exists()]
     if existing and not force:

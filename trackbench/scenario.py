@@ -293,7 +293,7 @@ def validate_terrain(t):
 
 def _check_geometry(v, tr):
     """Does the track fit the wheels? Cheap checks on the equilibrium configuration."""
-    from .model.equilibrium import initial_track
+    from .model.track_path import initial_track
     wc = wheel_centres_body(v)
     r = v["wheel_radius"]
     rho = r + tr["pad_wheel"]

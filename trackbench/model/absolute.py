@@ -30,11 +30,9 @@ from numba import njit
 from .jit import INLINE, KERNEL
 from .kernels import track_loads
 from .kinematics import body_offset, wheel_offset
+from .index import diag_tension, nq_of, pin_offset, z_arm, z_pin
 from .layout import (
-    ARMS_PHI0, D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA,
-    P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS,
-    Q_ARM, Q_PITCH, Q_X, Q_Y, Y_DISSIPATED, Y_WORK, Z_PITCH, Z_X, Z_Y, ZA_BETA, ZA_X, ZA_Y, diag_tension,
-    n_absolute, nq_of, pin_offset, z_arm, z_pin,
+    ARMS_PHI0, D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH, Q_X, Q_Y, Y_DISSIPATED, Y_WORK, Z_PITCH, Z_X, Z_Y, ZA_BETA, ZA_X, ZA_Y, n_absolute,
 )
 
 

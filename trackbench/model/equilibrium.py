@@ -13,11 +13,13 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
+from .index import n_coordinates, n_state
 from .jit import KERNEL
 from .bundles import arm_table, model_arrays, work_arrays
 from .parameters import equilibrium_arm_angle, pack, total_mass
 from .reduced import reduced_rhs
 from .terrain import flat_ground
+from .track_path import initial_track
 
 
 class EquilibriumError(RuntimeError):
@@ -62,35 +64,6 @@ class Equilibrium:
             "residual_N": self.residual,
             "residual_rel": self.residual / self.weight,
         }
-
-
-def _lower_hull(points):
-    """Lower convex hull, left to right (Andrew's monotone chain)."""
-    pts = sorted(map(tuple, points))
-    hull = []
-    for p in pts:
-        while len(hull) >= 2:
-            (x1, y1), (x2, y2) = hull[-2], hull[-1]
-            if (x2 - x1) * (p[1] - y1) - (y2 - y1) * (p[0] - x1) <= 0.0:
-                hull.pop()
-            else:
-                break
-        hull.append(p)
-    return np.array(hull)
-
-
-def initial_track(ends_world, wheel_centres, rho, n_links):
-    """Pins spread evenly along the taut path: the lower convex hull of the track ends
-    and the wheel circles of radius rho (wheel radius + pad). Pin 0 is the front end."""
-    ang = np.linspace(0.0, 2 * np.pi, 361)[:-1]
-    circ = [c + rho * np.column_stack([np.cos(ang), np.sin(ang)]) for c in wheel_centres]
-    hull = _lower_hull(np.vstack([ends_world] + circ))
-    hull = hull[::-1]  # front (largest x) to rear
-    seg = np.hypot(*np.diff(hull, axis=0).T)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    target = np.linspace(0.0, s[-1], n_links + 1)
-    pins = np.column_stack([np.interp(target, s, hull[:, 0]), np.interp(target, s, hull[:, 1])])
-    return pins, s[-1], hull
 
 
 class _Problem:
@@ -155,10 +128,10 @@ def _loads_at_rest(q, m, w, diag):
     """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
-    y = np.zeros(L.n_state(nq))
+    y = np.zeros(n_state(nq))
     for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
         y[k] = q[k]
-    ydot = np.empty(L.n_state(nq))
+    ydot = np.empty(n_state(nq))
     reduced_rhs(y, m, w, ydot, diag)
 
 
@@ -170,7 +143,7 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     par, arms = m.par, m.arms
     nw = arms.shape[0]
     n = apos.shape[0] - 1
-    nq = L.n_coordinates(nw, n)
+    nq = n_coordinates(nw, n)
     q = np.zeros(nq)
     q[L.Q_Y] = u[0]
     q[L.Q_PITCH] = u[1]

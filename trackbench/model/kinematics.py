@@ -9,7 +9,8 @@ from numba import njit
 
 from .bundles import ARM_COLS, ARM_COS, ARM_SIN
 from .jit import INLINE, KERNEL
-from .layout import P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y, q_pin
+from .index import q_pin
+from .layout import P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y
 
 
 @njit(**INLINE)

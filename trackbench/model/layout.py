@@ -22,13 +22,11 @@ Absolute state ``z`` of the "lee" solver (model/absolute.py)::
     z[z_arm(i) + ZA_X / ZA_Y / ZA_BETA]     arm i: road-wheel centre and absolute arm angle
     z[z_pin(nw) + 2*(b-1) + k]              free pin b, coordinate k
 
-Everything here is a plain constant or a compiled one-liner, so the kernels read
-``layout.Q_X`` or ``z_arm(i)`` and no kernel writes a bare index into a shared array.
+Everything here is a plain constant or a one-line function (model/index.py compiles the
+functions for the kernels; this module stays free of numba, so that validating a
+scenario or a study file does not load the compiler), and no kernel writes a bare index
+into a shared array.
 """
-
-from numba import njit
-
-from .jit import INLINE
 
 # --- generalised coordinates of the reduced solver --------------------------------
 Q_X = 0
@@ -37,13 +35,11 @@ Q_PITCH = 2
 Q_ARM = 3
 
 
-@njit(**INLINE)
 def pin_offset(n_wheels):
     """Index in q of the x coordinate of free pin 1."""
     return Q_ARM + n_wheels
 
 
-@njit(**INLINE)
 def q_pin(n_wheels, b):
     """Index in q of the x coordinate of free pin b (y is the next one)."""
     return Q_ARM + n_wheels + 2 * (b - 1)
@@ -54,18 +50,15 @@ Y_DISSIPATED = 1         # y[2 nq + Y_DISSIPATED]: D
 N_Y_EXTRA = 2            # first-order components after (q, qd); the error test leaves them out
 
 
-@njit(**INLINE)
 def n_state(nq):
     return 2 * nq + N_Y_EXTRA
 
 
-@njit(**INLINE)
 def nq_of(ny):
     """Number of generalised coordinates of a state of length ny."""
     return (ny - N_Y_EXTRA) // 2
 
 
-@njit(**INLINE)
 def n_coordinates(n_wheels, n_links):
     return Q_ARM + n_wheels + 2 * (n_links - 1)
 
@@ -81,13 +74,11 @@ ZA_Y = 1
 ZA_BETA = 2              # absolute arm angle beta_i = pitch + phi_i
 
 
-@njit(**INLINE)
 def z_arm(i):
     """Index in z of arm i's first coordinate (its wheel centre x)."""
     return Z_ARM + Z_PER_ARM * i
 
 
-@njit(**INLINE)
 def z_pin(n_wheels):
     """Index in z of the x coordinate of free pin 1 (the end of the rigid bodies)."""
     return Z_ARM + Z_PER_ARM * n_wheels
@@ -198,7 +189,6 @@ D_DISSIPATION = 16       # dD/dt: power dissipated by all dampers (W)
 D_WHEEL = 17             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
-@njit(**INLINE)
 def diag_tension(n_wheels):
     """Offset of the link tensions, one per link, in diag."""
     return D_WHEEL + 2 * n_wheels

@@ -22,11 +22,11 @@ from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, p
 from ..model.contact_laws import DAMPING_VISCOUS
 from ..model.jit import INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
-from ..model.layout import (K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS,
-                            NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH,
-                            Q_X, Q_Y, q_pin)
+from ..model.index import nq_of, q_pin
+from ..model.layout import (
+    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+)
 from .hermite import coordinate, quintic_basis
-from ..model.layout import nq_of
 
 BISECTIONS = 24
 

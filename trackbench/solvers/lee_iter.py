@@ -22,8 +22,8 @@ import math
 from numba import njit
 
 from ..model.absolute import add_phi_qt, gamma, phi_q_times
+from ..model.index import z_pin
 from ..model.jit import KERNEL
-from ..model.layout import z_pin
 
 
 @njit(**KERNEL)

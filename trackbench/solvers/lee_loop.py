@@ -39,7 +39,8 @@ from numba import njit
 from ..model.absolute import (applied_forces, constraint_matrix, contact_power, finish_diag, from_reduced,
                               joint_vectors, phi, to_reduced)
 from ..model.jit import KERNEL
-from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, Z_PITCH, ZA_BETA, Z_X, z_arm, z_pin
+from ..model.index import z_arm, z_pin
+from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, Z_PITCH, ZA_BETA, Z_X
 from ..status import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
 from .arrays import copy_2d, copy_into, set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step, finish_stats

@@ -13,7 +13,8 @@ import numpy as np
 from numba import njit
 
 from ..model.jit import INLINE, KERNEL
-from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK, nq_of
+from ..model.index import nq_of
+from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL

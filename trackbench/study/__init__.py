@@ -1,9 +1,18 @@
-"""Parameter studies: TOML grids run in parallel, kept as netCDF, resumable, summarised with pandas."""
+"""Parameter studies: TOML grids run in parallel, kept as netCDF, resumable, summarised with pandas.
+The parts load on first use (study file validation needs none of the heavy libraries)."""
 
-from .runner import run_study
-from .spec import StudyError, load_study
-from .store import StudyLocked
-from .summary import open_run, open_study, open_study_dataset
+_LAZY = {
+    "run_study": "runner", "StudyError": "spec", "load_study": "spec", "StudyLocked": "store",
+    "open_run": "summary", "open_study": "summary", "open_study_dataset": "summary",
+}
 
-__all__ = ["StudyError", "StudyLocked", "load_study", "open_run", "open_study", "open_study_dataset",
-           "run_study"]
+__all__ = sorted(_LAZY)
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'trackbench.study' has no attribute {name!r}")
+    import importlib
+    value = getattr(importlib.import_module(f".{_LAZY[name]}", __name__), name)
+    globals()[name] = value
+    return value

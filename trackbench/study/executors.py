@@ -150,7 +150,7 @@ def _simulate(task, rec):
     """The run's Dataset, or None (``rec`` failed) when the scenario or the solver raised."""
     try:
         from .. import __version__
-        from ..output import MODEL_VERSION
+        from ..version import MODEL_VERSION
         from ..scenario import Scenario
         from ..simulate import simulate
         rec.update(model_version=MODEL_VERSION, trackbench_version=__version__)

@@ -3,7 +3,7 @@
 import hashlib
 import json
 
-from ..output import MODEL_VERSION
+from ..version import MODEL_VERSION
 
 
 def run_id(scenario: dict, model_version: str = MODEL_VERSION) -> str:
