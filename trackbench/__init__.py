@@ -7,10 +7,10 @@ _jitcache.configure()  # before any compiled kernel is defined
 
 # the heavy parts (numba, xarray, pandas) load on first use: the command line's help and
 # the validation of scenarios and study files stay fast
+from .scenario import Scenario, ScenarioError  # noqa: E402  (light: no compiler)
+from .simulate import simulate  # noqa: E402  (light until called)
+
 _LAZY = {
-    "Scenario": ("scenario", "Scenario"),
-    "ScenarioError": ("scenario", "ScenarioError"),
-    "simulate": ("simulate", "simulate"),
     "open_study": ("study.summary", "open_study"),
     "open_study_dataset": ("study.summary", "open_study_dataset"),
 }

@@ -1,6 +1,8 @@
 """scenario -> xarray.Dataset: the one entry point the CLI, the studies and the API use.
 
     ds = trackbench.simulate(Scenario.paper(speed=15.0))
+
+The compiled solvers and xarray load on the first call, not at import.
 """
 
 import functools
@@ -10,16 +12,15 @@ import time
 import numpy as np
 
 from .model import layout as L
-from .model.equilibrium import solve_equilibrium
 from .model.bundles import arm_table, model_arrays, work_arrays
 from .model.parameters import arm_damping, pack, total_mass
 from .model.terrain import FAR, ground_from_points, obstacle_points
-from .output import build_dataset
 from .scenario import Scenario
 
 
 @functools.lru_cache(maxsize=32)
 def _equilibrium_cached(key):
+    from .model.equilibrium import solve_equilibrium
     vehicle, track, gravity, contact = json.loads(key)
     return solve_equilibrium(vehicle, track, gravity, contact)
 
@@ -149,6 +150,7 @@ def simulate(scenario: Scenario, progress=None):
         from .solvers.lee import run as run_solver
     else:
         from .solvers.rk import run as run_solver
+    from .output import build_dataset
     t_solve = time.perf_counter()
     result = run_solver(scenario, model, y0)
     solve_wall = time.perf_counter() - t_solve
