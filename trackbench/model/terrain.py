@@ -52,3 +52,62 @@ def obstacle_points(kind, x, height, length=0.0):
 
 def flat_ground():
     return ground_from_points([[-FAR, 0.0], [FAR, 0.0]])
+
+
+def contact_x(eq, height, pad_ground):
+    """x* of the spec: the largest x at which the resting track's ground-side surface
+    (links offset by h_g along the outer normal, circles of radius h_g at pins bent
+    convex towards the ground) is at the given height."""
+    a = eq.info["pins"]
+    best = -np.inf
+    t = np.diff(a, axis=0)
+    t /= np.hypot(t[:, 0], t[:, 1])[:, None]
+    n_out = np.column_stack([-t[:, 1], t[:, 0]])  # -n_inner
+    for b in range(len(t)):
+        p0 = a[b] + pad_ground * n_out[b]
+        p1 = a[b + 1] + pad_ground * n_out[b]
+        lo, hi = sorted((p0[1], p1[1]))
+        if lo <= height <= hi and p1[1] != p0[1]:
+            u = (height - p0[1]) / (p1[1] - p0[1])
+            best = max(best, p0[0] + u * (p1[0] - p0[0]))
+    for b in range(1, len(a) - 1):
+        if t[b - 1, 0] * t[b, 1] - t[b - 1, 1] * t[b, 0] < 0.0:  # convex towards the ground
+            dy = height - a[b, 1]
+            if abs(dy) <= pad_ground:
+                best = max(best, a[b, 0] + np.sqrt(pad_ground ** 2 - dy ** 2))
+    if not np.isfinite(best):
+        raise ValueError(f"the resting track never reaches height {height} m: the obstacle cannot be placed by "
+                         "first_contact_time; give terrain.position instead")
+    return float(best)
+
+
+def build_ground(scenario, eq):
+    """Terrain polyline of the scenario, with obstacles placed by time resolved."""
+    t = scenario["terrain"]
+    if t["kind"] == "flat":
+        return ground_from_points([[-FAR, 0.0], [FAR, 0.0]]), {}
+    if t["kind"] == "points":
+        return ground_from_points(t["points"]), {}
+    obstacles = t["obstacles"] if t["kind"] == "sequence" else [t]
+    pts = [[-FAR, 0.0]]
+    level = 0.0
+    x_end = -FAR
+    resolved = {}
+    for i, ob in enumerate(obstacles):
+        if "first_contact_time" in ob:
+            x = contact_x(eq, ob["height"], scenario["track.pad_ground"]) + scenario["speed"] * ob["first_contact_time"]
+            resolved[f"obstacle_{i}_position"] = x
+        elif "gap" in ob:
+            x = x_end + ob["gap"]
+        else:
+            x = ob["position"]
+        if x < x_end:
+            raise ValueError(f"terrain obstacle {i} starts at x = {x:.4g} m, before the previous one ends "
+                             f"({x_end:.4g} m)")
+        new = [[px, py + level] for px, py in obstacle_points(ob["kind"], x, ob["height"], ob.get("length", 0.0))]
+        pts += new
+        x_end = new[-1][0]
+        if ob["kind"] in ("step", "ramp"):
+            level += ob["height"]
+    pts.append([FAR, level])
+    return ground_from_points(pts), resolved

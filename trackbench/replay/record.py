@@ -16,8 +16,6 @@ equal to the Dataset's.
 
 import functools
 import json
-import os
-import tempfile
 import uuid
 from pathlib import Path
 
@@ -27,6 +25,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 from rerun.components import LineStrip2DBatch
 
+from ..atomic import atomic_path
 from . import geometry as G
 
 TIMELINE = "sim_time"
@@ -370,29 +369,18 @@ def write_recording(ds, path, every=1):
     idx = frame_indices(ds.sizes["time"], int(every))
     sc = G.scenario_of(ds)
     rec = rr.RecordingStream("trackbench", recording_id=str(uuid.uuid4()), send_properties=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    try:
-        rec.save(tmp, default_blueprint=blueprint(ds))
-        rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
-        # rerun encodes what was sent on its own thread while the next entity is prepared:
-        # the time series first (nothing to prepare), then the geometry
-        _log_signals(rec, ds)
-        _log_frames(rec, ds, idx)
-        _log_static(rec, ds)
-        rec.flush()
-        rec.disconnect()
-        os.replace(tmp, path)
-    except BaseException:
+    with atomic_path(path) as tmp:
         try:
-            rec.disconnect()
+            rec.save(tmp, default_blueprint=blueprint(ds))
+            rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
+            # rerun encodes what was sent on its own thread while the next entity is prepared:
+            # the time series first (nothing to prepare), then the geometry
+            _log_signals(rec, ds)
+            _log_frames(rec, ds, idx)
+            _log_static(rec, ds)
+            rec.flush()
         finally:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-        raise
+            rec.disconnect()
     return path
 
 

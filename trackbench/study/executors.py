@@ -23,7 +23,7 @@ def _now():
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
 
 
-def results_of(ds):
+def run_summary(ds):
     """The numbers of a run the summary shows (plain floats, SI units)."""
     out = {}
     for w, f, t in zip(ds["wheel"].values, ds["peak_wheel_force_y"].values, ds["peak_wheel_force_y_time"].values):
@@ -48,7 +48,7 @@ def _record(ds, rdir, scenario):
     try:
         target = Path(rdir) / "recording.rrd"
         tmp = store.tmp_path(target) + ".rrd"
-        try:
+        try:   # a writer of its own temporary: whatever happens inside, only a finished file lands
             write_recording(ds, tmp, every=int(scenario["record"].get("every", 1)))
             os.replace(tmp, target)
         finally:
@@ -172,7 +172,7 @@ def _write(ds, rdir, task, rec):
     msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-               timeseries="timeseries.nc", results=results_of(ds))
+               timeseries="timeseries.nc", results=run_summary(ds))
     rec["recording"], err = _record(ds, rdir, task["scenario"])
     if err:
         rec["recording_error"] = err

@@ -7,52 +7,23 @@
     <output>/.lock                    held by the `study run` working on the folder
     <output>/runs/<run-id>/timeseries.nc, run.json, recording.rrd
 
-Every file is written to a temporary name in its own folder (".<name>.<random>.tmp") and
-renamed into place, so a killed process never leaves a file that looks complete.
+Every file is written atomically (trackbench/atomic.py), so a killed process never leaves a
+file that looks complete.
 """
 
 import fcntl
 import json
 import os
-import tempfile
 import time
 from contextlib import contextmanager
 from pathlib import Path
 
-TMP_SUFFIX = ".tmp"
+from ..atomic import TMP_SUFFIX, atomic_path, tmp_path  # noqa: F401  (tmp_path: the workers' and clean_tmp's)
+
 
 
 class StudyLocked(RuntimeError):
     """Another process holds the study folder's lock."""
-
-
-def tmp_path(path):
-    """A fresh temporary name beside ``path``."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix="." + path.name + ".", suffix=TMP_SUFFIX, dir=path.parent)
-    os.close(fd)
-    return tmp
-
-
-def _umask():
-    m = os.umask(0)
-    os.umask(m)
-    return m
-
-
-@contextmanager
-def atomic_path(path):
-    """Yield a temporary path; on success rename it onto ``path``, on failure remove it."""
-    tmp = tmp_path(path)
-    try:
-        yield tmp
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the file the usual mode
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
 
 
 def write_text(path, text):
