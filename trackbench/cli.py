@@ -103,7 +103,7 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML).")):
         typer.echo(f"  failed {r.run_id}: {r.status_message}")
 
 
-# --- replay commands (issue 5) ------------------------------------------------------
+# --- replay commands ---------------------------------------------------------------
 
 @app.command()
 def view(

@@ -1,4 +1,4 @@
-"""Visual replay of runs (issue 5): rerun recordings (record), the paper's figures and study
+"""Visual replay of runs: rerun recordings (record), the paper's figures and study
 plots (plots, needs matplotlib), and `trackbench view` (view). Shared drawing: geometry.
 
     from trackbench.replay.record import write_recording, maybe_write_recording
