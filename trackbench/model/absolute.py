@@ -27,7 +27,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .jit import INLINE, KERNEL
+from .jit import BORROW, INLINE
 from .kernels import track_loads
 from .kinematics import body_offset, wheel_offset
 from .index import diag_tension, nq_of, pin_offset, z_arm, z_pin
@@ -48,7 +48,7 @@ def inverse_mass(par, n_wheels, n_links):
     return 1.0 / m
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def from_reduced(y, par, arms, z, zd):
     """Reduced state (q, qd, W, D) -> absolute z, zd; returns W. The wheel centres are
     placed as everywhere else (kinematics.wheel_offset)."""
@@ -84,7 +84,7 @@ def from_reduced(y, par, arms, z, zd):
     return y[2 * nq + Y_WORK]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def to_reduced(z, zd, work, nw, y):
     """Absolute z, zd and contact work -> reduced (q, qd, W, D = 0): phi_i = beta_i - theta."""
     nq = nq_of(y.shape[0])
@@ -103,7 +103,7 @@ def to_reduced(z, zd, work, nw, y):
     y[2 * nq + Y_DISSIPATED] = 0.0
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def joint_vectors(z, par, arms, geo):
     """Per joint i: geo[i] = (r_x, r_y, l cos beta, l sin beta) with r = R(theta) p_i.
     Then dr_i = (-r_y, r_x) and d(l e_i)/d beta = (-l sin beta, l cos beta)."""
@@ -117,7 +117,7 @@ def joint_vectors(z, par, arms, geo):
         geo[i, 3] = la * math.sin(beta)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def phi(z, geo, out):
     """Position constraints Phi (Eq. 1), 2 per joint; geo from joint_vectors(z)."""
     for i in range(geo.shape[0]):
@@ -126,7 +126,7 @@ def phi(z, geo, out):
         out[2 * i + 1] = z[Z_Y] + geo[i, 1] - z[j + ZA_Y] + geo[i, 3]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def phi_q_times(geo, u, out):
     """out = Phi_q u (u: body part of a velocity or acceleration vector)."""
     for i in range(geo.shape[0]):
@@ -135,7 +135,7 @@ def phi_q_times(geo, u, out):
         out[2 * i + 1] = u[Z_Y] + geo[i, 0] * u[Z_PITCH] - u[j + ZA_Y] + geo[i, 2] * u[j + ZA_BETA]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def add_phi_qt(geo, lam, scale, out):
     """out += scale * Phi_q^T lambda (body components only)."""
     for i in range(geo.shape[0]):
@@ -150,7 +150,7 @@ def add_phi_qt(geo, lam, scale, out):
         out[j + ZA_BETA] += -geo[i, 3] * lx + geo[i, 2] * ly
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def gamma(zd, geo, out):
     """Right side of the acceleration constraint: Phi_q zdd = gamma = theta'^2 r_i + beta_i'^2 l e_i,
     so the error of Eq. (14) is v = gamma - Phi_q zdd."""
@@ -161,7 +161,7 @@ def gamma(zd, geo, out):
         out[2 * i + 1] = w2 * geo[i, 1] + b2 * geo[i, 3]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def constraint_matrix(geo, minv, G):
     """G = Phi_q M^-1 Phi_q^T (the paper's C up to the factors of Eqs. 17-19)."""
     nw = geo.shape[0]
@@ -229,7 +229,7 @@ def _contact_only(fpin, lk, diag, t_off, fc):
         fc[b + 1, 1] += tn * lk[b, 1]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def applied_forces(z, zd, m, w, F, fc, diag):
     """F = applied generalised forces (no lambda) at z; fc = contact-only force on every
     pin (tension removed), w.fwheel = contact force on each wheel; diag filled by
@@ -266,7 +266,7 @@ def applied_forces(z, zd, m, w, F, fc, diag):
     _contact_only(fpin, w.lk, diag, diag_tension(nw), fc)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def contact_power(z, zd, ends, fc, fw, nw):
     """Power of the contact forces fc (on pins), fw (on wheels) at velocity zd; the same
     sum track_loads forms for D_POWER (pins 0 and n_links move with the chassis)."""
@@ -287,7 +287,7 @@ def contact_power(z, zd, ends, fc, fw, nw):
     return p
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def finish_diag(z, zd, zdd, par, arms, power, diag):
     """Fill what reduced_rhs fills beyond track_loads: kinetic, torsion and gravity
     energy, contact power and chassis acceleration."""

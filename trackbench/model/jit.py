@@ -13,3 +13,11 @@ rounds alike and a run is reproducible bit for bit.
 
 KERNEL = {"cache": True, "error_model": "numpy"}
 INLINE = dict(KERNEL, inline="always")
+
+# The solver loops and the right-hand sides never allocate: every array they touch is
+# allocated and held by the Python side for the whole run. Their bundles (named tuples of
+# arrays) would otherwise have every member's reference count raised and lowered,
+# atomically, at each call and at each field read (a quarter of the reduced solver's and
+# half of the lee solver's time). Without the runtime (NRT) no counts are kept: such a
+# function must not create an array.
+BORROW = dict(KERNEL, _nrt=False)

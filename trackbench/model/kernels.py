@@ -18,7 +18,7 @@ from .gaps import (link_frames, pin_ground_selection, pin_segment_valid, point_o
                    segment_coords, wedge)
 from .contact_force import normal_force
 from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, LAW_LINEAR
-from .jit import INLINE, KERNEL
+from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
     C_EVALUATIONS, D_DISSIPATION, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
@@ -64,7 +64,7 @@ def _near_pins(px, py, apos, reach, nbr, row):
     nbr[row, NB_COUNT] = n
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def build_neighbours(apos, wc, par, seg, corners, nbr, rows):
     """Fill the candidate lists: every pair that could touch while no pin or wheel
     moves more than half the skin from where it is now (rows: ModelArrays.nbr_rows)."""
@@ -164,7 +164,7 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     diag[D_POWER] -= dissipation   # the dashpots' work on the pins
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _link_load(fpin, avel, b, d0, length, fx, fy):
     """Eq. (7): split a force on link b at distance d0 from pin b to pins b and b+1;
     returns the power of the split force."""
@@ -196,7 +196,7 @@ def _link_rate(vx, vy, avel, lk, b, d0):
     return (vx - avel[b, 0]) * lk[b, 1] - (vy - avel[b, 1]) * lk[b, 0] + d0 * omega
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def law_force(law, delta, rate, mem, row, partner):
     """normal_force of one contact by a law beyond the paper's (compiled once, called:
     the paper's linear spring stays inline in the loops). For the laws by restitution
@@ -435,7 +435,7 @@ def track_loads(w, m, diag):
     ground_contacts(apos, avel, lk, fpin, par, seg, corners, nbr, rows, diag, mem)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def remember_onsets(m, w):
     """After an accepted step (the last evaluation was at its end state): pairs in contact
     there keep the approach speed of their onset, a pair that came into contact in the
@@ -455,7 +455,7 @@ def remember_onsets(m, w):
                 v0[row, p] = max(rates[row, p], v_min)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def onset_in_step(m, w):
     """Did a pair come into contact in the step just tried (in contact at its end, the
     last evaluation, with no approach speed remembered yet)? Only for the laws by

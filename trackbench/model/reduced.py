@@ -13,7 +13,7 @@ the order of a single loop.
 from numba import njit
 
 from .bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COS, ARM_Q, ARM_SIN
-from .jit import INLINE, KERNEL
+from .jit import BORROW, INLINE, KERNEL
 from .kernels import track_loads
 from .kinematics import body_offset, positions
 from .index import nq_of, q_pin
@@ -134,7 +134,7 @@ def _pins(par, nw, apos, avel, fpin, acc, ke, e_grav):
     return ke, e_grav
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def reduced_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for y = (q, qd, W, D); fills diag (forces, energies, status)."""
     par, arms = m.par, m.arms

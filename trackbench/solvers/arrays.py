@@ -4,24 +4,24 @@ message, which costs seconds on every cold start (~4 s for the reduced solver)."
 
 from numba import njit
 
-from ..model.jit import KERNEL
+from ..model.jit import BORROW, KERNEL
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def copy_into(dst, offset, src):
     """dst[offset:offset + len(src)] = src (1-D)."""
     for k in range(src.shape[0]):
         dst[offset + k] = src[k]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def set_row(a, i, v):
     """a[i, :] = v."""
     for k in range(v.shape[0]):
         a[i, k] = v[k]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def copy_2d(dst, src):
     """dst[:, :] = src (same shape)."""
     for i in range(src.shape[0]):

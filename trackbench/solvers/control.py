@@ -4,7 +4,7 @@ after a contact switch located in a rejected step (events.py)."""
 
 from numba import njit
 
-from ..model.jit import KERNEL
+from ..model.jit import BORROW, KERNEL
 
 from ..model.layout import S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, S_STATUS, S_STEPS, S_T_FINAL
 from ..status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
@@ -14,7 +14,7 @@ FAC_MIN = 0.2
 FAC_MAX = 10.0   # growth after an accepted step (1 right after a rejection)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def before_step(t, h, t_end, steps, rejected, max_steps, h_min):
     """(status, h): stop on too many attempts or a vanishing step; clip h to t_end."""
     if steps + rejected >= max_steps:
@@ -26,7 +26,7 @@ def before_step(t, h, t_end, steps, rejected, max_steps, h_min):
     return SUCCESSFUL, h
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def after_rejection(h, err, expo, th, h_min):
     """(h, at_switch) for the retry of a step rejected with error norm err (NaN allowed):
     end just after the contact switch at fraction th of the step if one was located
@@ -38,7 +38,7 @@ def after_rejection(h, err, expo, th, h_min):
     return h * FAC_MIN, False
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def after_acceptance(h, err, expo, fac_max, h_max):
     """The next step after an accepted one."""
     if err == 0.0:
@@ -48,7 +48,7 @@ def after_acceptance(h, err, expo, fac_max, h_max):
     return min(h * fac, h_max)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def finish_stats(stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi):
     """The run's figures into stats (layout.S_*)."""
     stats[S_STATUS] = status

@@ -20,7 +20,7 @@ from numba import njit
 from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, point_on_link,
                           segment_coords, wedge)
 from ..model.contact_laws import DAMPING_VISCOUS
-from ..model.jit import INLINE, KERNEL
+from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.index import nq_of, q_pin
 from ..model.layout import (
@@ -118,7 +118,7 @@ def _gap_end(kind, i, b, pins, wheels, m):
                  _reach(kind, m.par))
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
     """Upper end of the bracket where the gap crosses level (just after the kink)."""
     lo = 0.0
@@ -133,7 +133,7 @@ def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
     return hi
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     """Smallest t in (0, 1] at which some candidate contact starts or ends along the
     step's interpolant - or, with the viscous law, reaches the end of its dashpot's ramp,

@@ -4,7 +4,7 @@ interpolant through (q, qd, qdd) at both ends of the step (positions), its deriv
 
 from numba import njit
 
-from ..model.jit import INLINE, KERNEL
+from ..model.jit import BORROW, INLINE, KERNEL
 
 
 @njit(**INLINE)
@@ -33,7 +33,7 @@ def coordinate(w, step, k, nq):
     return quintic(w, h, y0[k], y0[nq + k], f0[nq + k], y1[k], y1[nq + k], f1[nq + k])
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def hermite_second_order(y0, f0, y1, f1, h, theta, nq, out):
     """State at t0 + theta h from (q, qd, qdd) at both ends of a step of a second-order
     system stored as y = (q, qd, extra): quintic Hermite for q, its derivative for qd,

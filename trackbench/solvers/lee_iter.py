@@ -23,10 +23,10 @@ from numba import njit
 
 from ..model.absolute import add_phi_qt, gamma, phi_q_times
 from ..model.index import z_pin
-from ..model.jit import KERNEL
+from ..model.jit import BORROW
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def inf_norm(G):
     g = 0.0
     for i in range(G.shape[0]):
@@ -37,7 +37,7 @@ def inf_norm(G):
     return g
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     """Fill An (= A_n / w_n) for C_1 = G / ||G||_inf; returns (alpha_n, ||G||_inf)."""
     m = G.shape[0]
@@ -75,7 +75,7 @@ def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     return 2.0 / (1.0 + eps), gn
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def update(lam, An, v, scale):
     """Eq. (15): lam -= scale * A_n v (scale = alpha / ||C||_inf)."""
     m = lam.shape[0]
@@ -86,7 +86,7 @@ def update(lam, An, v, scale):
         lam[i] -= scale * acc
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def max_abs(v):
     e = 0.0
     for i in range(v.shape[0]):
@@ -94,7 +94,7 @@ def max_abs(v):
     return e
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def norm2(v):
     s = 0.0
     for i in range(v.shape[0]):
@@ -102,7 +102,7 @@ def norm2(v):
     return math.sqrt(s)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
     """zdd (body part) = M^-1 (F - Phi_q^T lam); v = Eq. (14) error = gamma - Phi_q zdd."""
     for k in range(nbody):
@@ -115,7 +115,7 @@ def accel_error(F, geo, zd, minv, lam, nbody, zdd, gam, v):
         v[i] = gam[i] - v[i]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def acceleration_level(F, geo, zd, minv, lam, itm, tol, max_it, scratch):
     """Step 4: iterate lam with the acceleration error Eq. (14) (C = G, Eq. 19).
     itm = (A_n, alpha, ||G||_inf); scratch = (zdd, gamma, v): zdd holds the body part of
@@ -135,7 +135,7 @@ def acceleration_level(F, geo, zd, minv, lam, itm, tol, max_it, scratch):
     return -1, err
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     """Eq. (20): n_iter plain iterations (n = 1, alpha = 1.9) at the acceleration level;
     returns eps-bar-1 (clipped to (0, 1])."""
@@ -155,7 +155,7 @@ def estimate_eps1(F, geo, zd, minv, lam, gn, n_iter, nbody, zdd, gam, v):
     return min(1.0, max(est, 1e-6))
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def velocity_level(zd, geo_end, geos, bp, c, h, minv, lam, itm, tol, max_it, scratch):
     """Step 3: with the stage forces of step 1 held, the body velocity at t + h depends on
     the end value lam of the multipliers (linear over the step) through

@@ -38,7 +38,7 @@ from numba import njit
 
 from ..model.absolute import (applied_forces, constraint_matrix, contact_power, finish_diag, from_reduced,
                               joint_vectors, phi, to_reduced)
-from ..model.jit import KERNEL
+from ..model.jit import BORROW
 from ..model.index import z_arm, z_pin
 from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, Z_PITCH, ZA_BETA, Z_X
 from ..status import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
@@ -63,12 +63,12 @@ DIAG_ACC_TOL = 1e-10
 DIAG_MAX_IT = 1000
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _itm(lw):
     return lw.An, lw.sc[SC_ALPHA], lw.sc[SC_GN]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _reported(F, geo, zd, minv, lam, lw, lstats):
     """The acceleration level iterated on a copy (lw.lam_d) to DIAG_ACC_TOL: what diag
     and the joint forces report. Counts the iterations (or one that did not converge)."""
@@ -81,7 +81,7 @@ def _reported(F, geo, zd, minv, lam, lw, lstats):
         lstats[L_IT_DIAG] += it
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _build_matrices(z, geo, ls, minv, lw, lstats):
     """A_n and alpha (A1-A6) from C at configuration z (joint vectors geo); remembers
     the angles they were built at."""
@@ -95,7 +95,7 @@ def _build_matrices(z, geo, ls, minv, lw, lstats):
         lw.ang_ref[1 + i] = z[z_arm(i) + ZA_BETA]
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _start(y0, h, ls, minv, m, w, lw, out, lout):
     """t = 0: forces, eps-bar-1 by Eq. (20), A_n, then the acceleration level for
     lambda(0); the first sample and the energy references. Returns (status, e_ref, r_ref)."""
@@ -140,7 +140,7 @@ def _start(y0, h, ls, minv, m, w, lw, out, lout):
     return status, e_ref, r_ref
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _position_level(h, h_prev, tab, ls, minv, m, w, lw, lstats):
     """Step 1: re-integrate the step while iterating lam1 with Eq. (12).
     Returns (converged, final max |Phi|, iterations, stage evaluations)."""
@@ -177,7 +177,7 @@ def _position_level(h, h_prev, tab, ls, minv, m, w, lw, lstats):
     return ok, err_p, updates, n_eval
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _locate_switch(h, tab, m, ev, lw, nw):
     """Step 2 on a rejection: the contact switch inside the step, on its ends in reduced
     coordinates (the last stage, c = 1, is the acceleration at t + h)."""
@@ -189,7 +189,7 @@ def _locate_switch(h, tab, m, ev, lw, nw):
     return first_contact_switch(lw.ev_y0, lw.ev_f0, lw.ev_y1, lw.ev_f1, h, m, ev)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _maybe_rebuild(ls, minv, lw, lstats):
     """A_n again where the pitch or an arm angle moved more than rebuild_angle."""
     ns = lw.geos.shape[0]
@@ -200,7 +200,7 @@ def _maybe_rebuild(ls, minv, lw, lstats):
         _build_matrices(lw.Y, lw.geos[ns - 1], ls, minv, lw, lstats)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _velocity_and_acceleration(h, tab, ls, minv, lw, lstats):
     """Steps 3 and 4: qd(t + h) of the bodies, then lambda(t + h) and qdd(t + h).
     Returns (velocity iterations, error, acceleration iterations, error)."""
@@ -222,7 +222,7 @@ def _velocity_and_acceleration(h, tab, ls, minv, lw, lstats):
     return it_v, err_v, it_a, err_a
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _end_state(h, tab, minv, m, lw, lstats):
     """The contact work over the step and diag at t + h (the reported multipliers).
     Returns (W(t + h), p_end)."""
@@ -249,7 +249,7 @@ def _end_state(h, tab, minv, m, lw, lstats):
     return w_new, p_end
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _count_step(h, errors, iterations, ptol, lw, lstats):
     """Figures of an accepted step: into the run totals and the per-sample accumulator."""
     err_p, err_v, err_a = errors
@@ -274,7 +274,7 @@ def _count_step(h, errors, iterations, ptol, lw, lstats):
     acc_x[X_H] = h
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _samples(t, h, n_out, ctl, ls, minv, m, w, lw, out, lout):
     """Output samples in (t, t + h]: Hermite state, forces, the acceleration level with
     lambda interpolated over the step. Returns (new sample count, evaluations)."""
@@ -310,7 +310,7 @@ def _samples(t, h, n_out, ctl, ls, minv, m, w, lw, out, lout):
     return n_out, n_eval
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _shift(w_new, p_end, lw):
     """The end of this step is the start of the next."""
     ns = lw.K.shape[0]
@@ -327,7 +327,7 @@ def _shift(w_new, p_end, lw):
     copy_into(lw.lam0, 0, lw.lam_s)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _accepted_status(lw):
     status = SUCCESSFUL
     for k in range(lw.z.shape[0]):
@@ -339,7 +339,7 @@ def _accepted_status(lw):
     return status
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def integrate_lee(y0, ctl, tab, ls, minv, m, w, ev, lw, out, lout):
     """The paper's procedure (module docstring) from the reduced state y0 to ctl.t_end."""
     nw = m.arms.shape[0]

@@ -16,12 +16,12 @@ import math
 from numba import njit
 
 from ..model.absolute import add_phi_qt, applied_forces, contact_power, joint_vectors
-from ..model.jit import KERNEL
+from ..model.jit import BORROW
 from .arrays import copy_2d
 from .hermite import hermite_second_order
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def rkn_pass(h, tab, minv, m, w, lw):
     """Stages 2..s of the RKN pair from (lw.z, lw.zd) with lambda linear from lw.lam0 to
     lw.lam1 (stage 1, K[0], is the acceleration at t). Contacts are re-detected at every
@@ -58,7 +58,7 @@ def rkn_pass(h, tab, minv, m, w, lw):
         zd_new[k] = zd[k] + h * acc
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     """RMS over positions and velocities of the embedded estimate (h^2 sum eb k, h sum ebp k)
     scaled by atol + rtol max(|old|, |new|)."""
@@ -78,7 +78,7 @@ def error_norm(z, zd, Y, zd_new, K, eb, ebp, h, rtol, atol):
     return math.sqrt(s / (2 * nz))
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def work_increment(h, tab, ends, nw, p_start, p_end, lw):
     """Contact work over the step: W' = P(t) = contact force . velocity, integrated by the
     pair's velocity weights, h sum_j bp_j P_j (exact for polynomials of degree 5 in time):

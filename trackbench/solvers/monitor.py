@@ -5,7 +5,7 @@ import numpy as np
 from numba import njit
 
 from ..model.energy import paper_balance, work_residual
-from ..model.jit import INLINE, KERNEL
+from ..model.jit import BORROW, INLINE, KERNEL
 
 from ..model.layout import (
     D_CHASSIS_AY, D_CORNER_FORCE, D_E_GRAVITY, D_OBSTACLE_FORCE, D_E_KINETIC, D_E_PAD_GROUND, D_E_PAD_WHEEL,
@@ -27,20 +27,20 @@ _SLOTS = (D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_CHASSIS_AY, D_CHASSIS_AY)
 _SIGNS = (1.0, 1.0, -1.0, 1.0, -1.0)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def energy_balance(diag):
     """The paper's balance: kinetic + elastic (torsion, tension, pads) + gravity potential."""
     return paper_balance(diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_TENSION], diag[D_E_PAD_WHEEL],
                          diag[D_E_PAD_GROUND], diag[D_E_GRAVITY])
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def energy_residual(diag, work):
     """Kinetic + torsion + tension + gravity - work of the contact forces (continuous)."""
     return work_residual(diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_TENSION], diag[D_E_GRAVITY], work)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def init_peaks(peaks):
     peaks[:, 0] = -np.inf
     peaks[:, 1] = np.nan
@@ -101,7 +101,7 @@ def _up(peaks, k, v, t, t_switch):
     peaks[k, 5] = t
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
     shortened to end just after a located contact switch (solvers/events.py)."""

@@ -12,7 +12,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ..model.jit import INLINE, KERNEL
+from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.index import nq_of
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
@@ -86,7 +86,7 @@ def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     return abs(h) * math.sqrt(s5 / n)
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def _start(y0, m, w, lw, out):
     """t = 0: the first derivative (row 0 of K), the energy references, the first sample.
     Returns (status, e_ref, r_ref)."""
@@ -148,7 +148,7 @@ def _accepted_status(y_new, diag):
     return status
 
 
-@njit(**KERNEL)
+@njit(**BORROW)
 def integrate(y0, ctl, tab, m, w, ev, lw, out):
     A, b, e, e3, expo = tab.A, tab.b, tab.e, tab.e3, tab.expo
     K, y, y_new, ys, er5, er3, diag = lw.K, lw.y, lw.y_new, lw.ys, lw.er5, lw.er3, lw.diag
