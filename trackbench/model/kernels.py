@@ -130,19 +130,10 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     energy = 0.0
     tmin = np.inf
     tmax = -np.inf
-    n_links = apos.shape[0] - 1
-    for b in range(n_links):  # lengths first: a loop of square roots that vectorises
-        dx = apos[b + 1, 0] - apos[b, 0]
-        dy = apos[b + 1, 1] - apos[b, 1]
-        lk[b, 0] = dx
-        lk[b, 1] = dy
-        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
-    for b in range(n_links):
-        inv = 1.0 / lk[b, 2]
-        tx = lk[b, 0] * inv
-        ty = lk[b, 1] * inv
-        lk[b, 0] = tx
-        lk[b, 1] = ty
+    link_frames(apos, lk)
+    for b in range(apos.shape[0] - 1):
+        tx = lk[b, 0]
+        ty = lk[b, 1]
         stretch = lk[b, 2] - l0
         tension = k * stretch
         if c != 0.0:
