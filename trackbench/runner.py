@@ -39,29 +39,42 @@ def _energy_line(ds, s):
     if dissipated > 0.0:
         closed = ds["energy_balance_error"].values + (ds["energy_dissipated"].values - ds["energy_dissipated"].values[0]) \
             / float(ds.attrs["initial_total_energy"])
-        return (f"  energy balance + dissipated {100 * float(abs(closed).max()):.4f} % (dissipated "
+        return (f"  energy balance + dissipated       {100 * float(abs(closed).max()):.4f} % (dissipated "
                 f"{dissipated / 1e3:.1f} kJ){tail}")
-    return f"  energy balance error      {100 * s['max_energy_balance_error']:.4f} % (paper: < 0.06 %){tail}"
+    return f"  energy balance error              {100 * s['max_energy_balance_error']:.4f} % (paper: < 0.06 %){tail}"
 
 
 def format_summary(ds, path=None):
     from .output import summary_numbers
-    s = summary_numbers(ds)
-    lines = [f"trackbench run '{ds.attrs['title'].split(': ', 1)[-1]}': {ds.attrs['status']}"
-             + ("" if ds.attrs["status"] == "completed" else f" at t = {ds.attrs['t_final']:.6g} s: {ds.attrs['status_message']}")]
-    lines.append("  peak vertical wheel-track force (kN) and time (s):")
+    from .quantities import BY_NAME as q
+    s, a = summary_numbers(ds), ds.attrs
+    lines = [f"trackbench run '{a['title'].split(': ', 1)[-1]}': {a['status']}"
+             + ("" if a["status"] == "completed" else f" at t = {a['t_final']:.6g} s: {a['status_message']}")]
+    wheel = q["peak_wheel_force_y"]
+    lines.append(f"  {wheel.label} ({wheel.unit}) and time (s):")
     for w, f, t in zip(ds.wheel.values, ds.peak_wheel_force_y.values, ds.peak_wheel_force_y_time.values):
-        lines.append(f"    wheel {int(w)}: {f / 1e3:10.1f}  at {t:.4f}")
+        lines.append(f"    wheel {int(w)}: {wheel.display(f):10.1f}  at {t:.4f}")
+
+    def shown(name):  # the summary number of a quantity, in its display unit
+        return s[q[name].display_key(name)]
+
+    def line(label, text):
+        return f"  {label:34s}{text}"
+
+    ground, tension, ay, vx = (q[n] for n in ("peak_ground_force_y", "peak_link_tension", "peak_chassis_ay",
+                                                "min_chassis_vx"))
+    contact, compression = q["first_contact_time"], q["first_compression_time"]
     lines += [
-        f"  peak total ground force   {s['peak_ground_force_y_kN']:10.1f} kN at {float(ds.peak_ground_force_y_time):.4f} s",
-        f"  peak link tension         {s['peak_link_tension_kN']:10.1f} kN",
-        f"  chassis vertical accel    {s['min_chassis_ay']:+.2f} .. {s['peak_chassis_ay']:+.2f} m/s^2",
-        f"  min chassis speed         {s['min_chassis_vx']:.4f} m/s",
-        f"  first obstacle contact    {_time(s['first_contact_time'], 5)}; first link compression {_time(s['first_compression_time'], 4)}",
+        line(ground.label, f"{shown(ground.name):10.1f} {ground.unit} at {float(ds.peak_ground_force_y_time):.4f} s"),
+        line(tension.label, f"{shown(tension.name):10.1f} {tension.unit}"),
+        line("chassis vertical acceleration", f"{shown('min_chassis_ay'):+.2f} .. {shown(ay.name):+.2f} {ay.unit}"),
+        line(vx.label, f"{shown(vx.name):.4f} {vx.unit}"),
+        line(contact.label, f"{_time(shown(contact.name), 5)}; {compression.label} "
+                            f"{_time(shown(compression.name), 4)}"),
         _energy_line(ds, s),
-        f"  steps {ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected), wall time {ds.attrs['wall_time']:.3f} s",
+        f"  steps {a['steps']} (+{a['rejected_steps']} rejected), wall time {a['wall_time']:.3f} s",
     ]
-    if s["first_compression_time"] == s["first_compression_time"]:   # a link went into compression
+    if shown(compression.name) == shown(compression.name):   # a link went into compression
         lines.append("  note: peaks after the first compression are sensitive to tiny changes (chaotic motion); "
                      "compare them as ranges.")
     if path:

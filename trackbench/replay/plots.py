@@ -233,24 +233,30 @@ def plot_run(ds_or_path, out_dir, times=DEFAULT_TIMES):
 
 BOOKKEEPING = {"run_id", "status", "status_message", "variant", "replicate", "steps", "rejected_steps", "t_final",
                "wall_time", "solve_time", "recording", "recording_error", "seed"}
-RESULT_PREFIXES = ("peak_", "min_", "max_", "first_")
 
 
 def study_axes(df):
-    """Grid axes of a study summary: every column that is neither book-keeping nor a result
-    (peak_*, min_*, max_*, first_*, *_time) and takes more than one value."""
+    """Grid axes of a study summary: every column that is neither book-keeping nor a summary
+    quantity (trackbench/quantities.py) and takes more than one value."""
+    from ..quantities import quantity_of
     axes = []
     for c in df.columns:
-        if c in BOOKKEEPING or c.startswith(RESULT_PREFIXES) or c.endswith("_time"):
+        if c in BOOKKEEPING or quantity_of(c) is not None:
             continue
         if df[c].nunique(dropna=True) > 1:
             axes.append(c)
     return axes
 
 
+def _wheel_of(column):
+    from ..quantities import BY_NAME
+    return BY_NAME["peak_wheel_force_y"].wheel_of(column)
+
+
 def _wheel_columns(df):
-    cols = [c for c in df.columns if c.startswith("peak_wheel") and c.endswith("_force_y")]
-    return sorted(cols, key=lambda c: int(c[len("peak_wheel"):-len("_force_y")]))
+    from ..quantities import BY_NAME
+    wheel = BY_NAME["peak_wheel_force_y"]
+    return sorted(wheel.present(df.columns), key=wheel.wheel_of)
 
 
 def _find_summary(study_dir):
@@ -280,7 +286,8 @@ def plot_study(study_dir, out_dir):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     wheel_cols = _wheel_columns(df)
-    other_cols = [c for c in ("peak_ground_force_y", "peak_link_tension") if c in df.columns]
+    from ..quantities import PEAKS
+    other_cols = [q.name for q in PEAKS if q.unit == "kN" and not q.per_wheel and q.name in df.columns]
     ok = df[df["status"] == "completed"] if "status" in df.columns else df
     bad = df[df["status"] != "completed"] if "status" in df.columns else df.iloc[:0]
     paths = []
@@ -306,7 +313,7 @@ def plot_study(study_dir, out_dir):
             for k, c in enumerate(cols):
                 y = ok[c].astype(float).to_numpy() / 1e3
                 x = xpos(ok[axis])
-                label = (f"wheel {c[len('peak_wheel'):-len('_force_y')]}" if c.startswith("peak_wheel")
+                label = (f"wheel {_wheel_of(c)}" if _wheel_of(c) is not None
                          else c.replace("peak_", "peak ").replace("_", " "))
                 ax.plot(x, y, "o", color=f"C{k}", ms=4, alpha=0.6)
                 xs = np.array(order, dtype=float) if numeric else np.arange(len(order), dtype=float)

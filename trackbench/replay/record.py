@@ -174,16 +174,17 @@ def solver_text(ds):
             "rhs_evaluations", "min_step", "max_step", "neighbour_rebuilds", "wall_time", "solve_time",
             "initial_total_energy", "weight", "trackbench_version", "model_version")
     rows = [(k, a[k]) for k in keys if k in a]
-    for name in ("peak_wheel_force_y",):
-        if name in ds:
-            rows += [(f"{name} wheel {int(w)} (N)", f"{float(f):.6g} at t = {float(t):.5f} s")
-                     for w, f, t in zip(ds.variables["wheel"].values, ds.variables[name].values, ds.variables[name + "_time"].values)]
-    for name in ("peak_ground_force_y", "peak_link_tension", "min_link_tension", "peak_chassis_ay",
-                 "min_chassis_ay", "min_chassis_vx", "max_energy_balance_error", "max_energy_residual",
-                 "first_contact_time", "first_compression_time"):
-        if name in ds:
-            units = ds.variables[name].attrs.get("units", "")
-            rows.append((f"{name} ({units})", f"{float(ds.variables[name].values):.6g}"))
+    from ..quantities import TABLE
+    for q in TABLE:   # every summary quantity, in SI units
+        if q.variable not in ds:
+            continue
+        v, units = ds.variables[q.variable], ds.variables[q.variable].attrs.get("units", "")
+        if q.per_wheel:
+            t = ds.variables[q.variable + "_time"].values
+            rows += [(f"{q.variable} wheel {int(w)} ({units})", f"{float(f):.6g} at t = {float(tw):.5f} s")
+                     for w, f, tw in zip(ds.variables["wheel"].values, v.values, t)]
+        else:
+            rows.append((f"{q.variable} ({units})", f"{float(v.values):.6g}"))
     text = "# Solver statistics\n\n" + _md_table(rows)
     if "equilibrium" in a:
         text += "\n\n## Initial equilibrium\n\n```json\n" + json.dumps(G.attr_json(ds, "equilibrium"), indent=1) + "\n```"

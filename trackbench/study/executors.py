@@ -3,7 +3,6 @@
 Tasks and results are plain dicts (picklable, no Scenario objects)."""
 
 import errno
-import math
 import os
 import shutil
 import socket
@@ -24,17 +23,9 @@ def _now():
 
 
 def run_summary(ds):
-    """The numbers of a run the summary shows (plain floats, SI units)."""
-    out = {}
-    for w, f, t in zip(ds["wheel"].values, ds["peak_wheel_force_y"].values, ds["peak_wheel_force_y_time"].values):
-        out[f"peak_wheel{int(w)}_force_y"] = float(f)
-        out[f"peak_wheel{int(w)}_force_y_time"] = float(t)
-    for name in ("peak_ground_force_y", "peak_link_tension", "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx"):
-        out[name] = float(ds[name])
-        out[name + "_time"] = float(ds[name + "_time"])
-    for name in ("first_contact_time", "first_compression_time", "max_energy_balance_error", "max_energy_residual"):
-        out[name] = float(ds[name])
-    return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in out.items()}
+    """The numbers of a run the summary shows (plain floats, SI units; NaN -> None)."""
+    from .. import quantities as Q
+    return Q.without_nan(Q.values(ds))
 
 
 def _record(ds, rdir, scenario):

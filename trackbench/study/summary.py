@@ -5,12 +5,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from .. import quantities as Q
 from . import store
 from .spec import Run, Study, load_study
 
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
-PEAKS = ("peak_ground_force_y", "peak_link_tension", "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx")
-TAIL = ("first_contact_time", "first_compression_time", "max_energy_balance_error", "max_energy_residual")
+# the results in the study table on screen, in its column order (vertical acceleration as min, max)
+SCREEN = ("peak_wheel_force_y", "peak_ground_force_y", "peak_link_tension", "min_chassis_ay", "peak_chassis_ay",
+          "min_chassis_vx", "first_compression_time")
 
 
 def _wheels(study):
@@ -18,17 +20,14 @@ def _wheels(study):
     return max(n)
 
 
-def quantities(study):
-    """Per-run peak quantities, in summary order (replicate statistics use these)."""
-    return [f"peak_wheel{w}_force_y" for w in range(1, _wheels(study) + 1)] + list(PEAKS)
+def peak_columns(study):
+    """The summary's peak columns, in summary order (replicate statistics cover these)."""
+    return Q.peak_columns(_wheels(study))
 
 
 def summary_frame(study):
     """One row per run of the study (pending when it has not run), from the runs' run.json."""
-    qs = quantities(study)
-    timed = []
-    for q in qs:
-        timed += [q, q + "_time"]
+    results = Q.summary_columns(_wheels(study))
     rows = []
     for run in study.runs:
         rec = store.read_run(study.output, run.run_id) or {"status": "pending", "status_message": ""}
@@ -36,12 +35,12 @@ def summary_frame(study):
         row = {"run_id": run.run_id, "status": rec["status"], "status_message": rec.get("status_message", ""),
                "variant": run.variant, "replicate": run.replicate}
         row.update({n: run.params.get(n) for n in study.param_names})
-        row.update({k: res.get(k) for k in timed + list(TAIL)})
+        row.update({k: res.get(k) for k in results})
         for k in ("steps", "rejected_steps", "t_final", "wall_time", "solve_time"):
             row[k] = rec.get(k)
         rows.append(row)
     df = pd.DataFrame(rows)
-    num = timed + list(TAIL) + ["t_final", "wall_time", "solve_time"]
+    num = results + ["t_final", "wall_time", "solve_time"]
     df[num] = df[num].astype(float)
     for k in ("steps", "rejected_steps"):
         df[k] = df[k].astype("Int64")
@@ -59,7 +58,7 @@ def replicate_frame(study, df):
         row = {"variant": v, **{p: g[p].iloc[0] for p in params},
                "replicates": len(g), "completed": len(ok)}
         flagged = []
-        for q in quantities(study):
+        for q in peak_columns(study):
             x = ok[q].dropna()
             med = float(x.median()) if len(x) else np.nan
             lo, hi = (float(x.min()), float(x.max())) if len(x) else (np.nan, np.nan)
@@ -84,19 +83,14 @@ def write_summary(study):
 
 
 def format_table(df, rep=None, params=()):
-    """A screen-sized table: forces in kN."""
+    """A screen-sized table: the SCREEN quantities in their display units (forces in kN)."""
     show = pd.DataFrame({"run": df.run_id.str[:8], "status": df.status})
     for p in params:
         show[p] = df[p]
-    wheels = [c for c in df.columns if c.startswith("peak_wheel") and not c.endswith("_time")]
-    for c in wheels:
-        show["w" + c[len("peak_wheel"):-len("_force_y")] + " kN"] = df[c] / 1e3
-    show["ground kN"] = df.peak_ground_force_y / 1e3
-    show["tension kN"] = df.peak_link_tension / 1e3
-    show["ay min"] = df.min_chassis_ay
-    show["ay max"] = df.peak_chassis_ay
-    show["vx min"] = df.min_chassis_vx
-    show["compr s"] = df.first_compression_time
+    for name in SCREEN:
+        q = Q.BY_NAME[name]
+        for c in q.present(df.columns):
+            show[q.heading.format(q.wheel_of(c))] = q.display(df[c])
     show["wall s"] = df.wall_time
     text = show.to_string(index=False, float_format=lambda x: f"{x:.4g}", na_rep="-")
     bad = df[df.status == "failed"]
@@ -105,9 +99,10 @@ def format_table(df, rep=None, params=()):
     if rep is not None:
         cols = [p for p in params if p != "seed"] + ["completed"]
         t = rep[cols].copy()
-        t["ground kN median [min, max]"] = [
-            f"{a / 1e3:.4g} [{b / 1e3:.4g}, {c / 1e3:.4g}]" for a, b, c in
-            zip(rep.peak_ground_force_y_median, rep.peak_ground_force_y_min, rep.peak_ground_force_y_max)]
+        g = Q.BY_NAME["peak_ground_force_y"]
+        t[g.heading + " median [min, max]"] = [
+            f"{g.display(a):.4g} [{g.display(b):.4g}, {g.display(c):.4g}]" for a, b, c in
+            zip(rep[g.name + "_median"], rep[g.name + "_min"], rep[g.name + "_max"])]
         t["spread > 5 %"] = rep.sensitive.replace("", "-")
         text += "\n\nreplicates (median, min, max over seeds; full table in replicates.csv):\n"
         text += t.to_string(index=False)

@@ -1,0 +1,53 @@
+"""The summary quantities are one table (trackbench/quantities.py): every place that shows
+or stores a run's summary reads it, and it matches the Dataset."""
+
+import pandas as pd
+
+from trackbench import output, quantities
+from trackbench.replay.plots import study_axes
+from trackbench.study.executors import run_summary
+
+SI_OF = {"kN": "N", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1"}
+
+
+def test_the_table_matches_the_dataset(paper_run_short):
+    """Every quantity is a Dataset variable whose SI unit its display unit converts from;
+    each peak has its _time."""
+    for q in quantities.TABLE:
+        var = paper_run_short[q.variable]
+        assert var.attrs["units"] == SI_OF[q.unit], q.variable
+        assert var.dims == (("wheel",) if q.per_wheel else ()), q.variable
+        assert q.kind in ("peak", "event", "check")
+        if q.kind == "peak":
+            assert paper_run_short[q.variable + "_time"].attrs["units"] == "s"
+
+
+def test_summary_columns_in_the_documented_order():
+    wheels = [c for w in (1, 2) for c in (f"peak_wheel{w}_force_y", f"peak_wheel{w}_force_y_time")]
+    assert quantities.summary_columns(2) == wheels + [
+        "peak_ground_force_y", "peak_ground_force_y_time", "peak_link_tension", "peak_link_tension_time",
+        "peak_chassis_ay", "peak_chassis_ay_time", "min_chassis_ay", "min_chassis_ay_time",
+        "min_chassis_vx", "min_chassis_vx_time", "first_contact_time", "first_compression_time",
+        "max_energy_balance_error", "max_energy_residual"]
+    assert quantities.peak_columns(2) == wheels[0::2] + ["peak_ground_force_y", "peak_link_tension",
+                                                         "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx"]
+
+
+def test_run_json_screen_summary_and_table_agree(paper_run_short):
+    v = quantities.values(paper_run_short)
+    assert list(v) == quantities.summary_columns(paper_run_short.sizes["wheel"])
+    assert list(run_summary(paper_run_short)) == list(v)
+    assert v["peak_wheel3_force_y"] == float(paper_run_short.peak_wheel_force_y.sel(wheel=3))
+    assert v["min_chassis_vx_time"] == float(paper_run_short.min_chassis_vx_time)
+    s = output.summary_numbers(paper_run_short)
+    assert s["peak_link_tension_kN"] == v["peak_link_tension"] / 1e3 and s["peak_chassis_ay"] == v["peak_chassis_ay"]
+    assert "min_link_tension" not in v and "min_link_tension_kN" not in s  # in the Dataset, not the summary
+    for c in v:
+        q, wheel = quantities.quantity_of(c)
+        assert (wheel is not None) == q.per_wheel
+
+
+def test_a_placement_parameter_ending_in_time_is_a_study_axis():
+    df = pd.DataFrame({"terrain.first_contact_time": [0.05, 0.06], "peak_wheel12_force_y": [1.0, 2.0],
+                       "max_energy_residual": [1e-9, 2e-9], "peak_link_tension_time": [0.1, 0.2]})
+    assert study_axes(df) == ["terrain.first_contact_time"]

@@ -1,0 +1,139 @@
+"""The summary quantities of a run, in one table.
+
+Every place that shows or stores a run's summary reads this table: the one-screen summary
+of `trackbench run` (runner.format_summary, output.summary_numbers), a study run's run.json
+``results`` and summary.csv columns (study/executors.py, study/summary.py), the replicate
+statistics, the study table on screen, the study plots and the solver text of a recording.
+The Dataset variables themselves are built by output.py (SI units, with long_names).
+
+Kinds: a "peak" is an extremum of the motion, stored with its time (``<column>_time``) and
+given replicate statistics; an "event" is the time something first happened; a "check" is
+an accuracy figure of the run.
+"""
+
+import math
+import re
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Quantity:
+    name: str            # summary column (run.json key); "{}" stands for the wheel number
+    variable: str        # Dataset variable (SI units; along `wheel` when the name has "{}")
+    kind: str            # "peak", "event" or "check" (module docstring)
+    unit: str            # display unit
+    per_unit: float      # SI value of one display unit: shown value = SI value / per_unit
+    label: str           # words for people: summaries, plot legends
+    heading: str | None  # column heading in the study table on screen ("{}": wheel number)
+    late: bool           # decided after the motion turns chaotic (first link compression):
+    #                      differs by 10-60 % between correct runs, compare as a range
+    summary: bool = True  # in the summary (run.json, summary.csv, one-screen summary)
+
+    @property
+    def per_wheel(self):
+        return "{}" in self.name
+
+    def columns(self, n_wheels):
+        """Summary column names, one per road wheel for a per-wheel quantity."""
+        if self.per_wheel:
+            return [self.name.format(w) for w in range(1, n_wheels + 1)]
+        return [self.name]
+
+    def present(self, columns):
+        """This quantity's summary columns among ``columns``, in their order."""
+        return [c for c in columns if c == self.name or self.wheel_of(c) is not None]
+
+    def display(self, si_value):
+        return si_value / self.per_unit
+
+    def display_key(self, column):
+        """output.summary_numbers' key: the column, with the unit when it is not SI."""
+        return column if self.per_unit == 1 else f"{column}_{self.unit}"
+
+    def wheel_of(self, column):
+        """The wheel number of one of this quantity's columns, else None."""
+        m = re.fullmatch(re.escape(self.name).replace(r"\{\}", r"(\d+)"), column) if self.per_wheel else None
+        return int(m.group(1)) if m else None
+
+
+Q = Quantity
+TABLE = (
+    Q("peak_wheel{}_force_y", "peak_wheel_force_y", "peak", "kN", 1e3, "peak vertical wheel-track force",
+      "w{} kN", late=True),
+    Q("peak_ground_force_y", "peak_ground_force_y", "peak", "kN", 1e3, "peak total ground force", "ground kN",
+      late=True),
+    Q("peak_link_tension", "peak_link_tension", "peak", "kN", 1e3, "peak link tension", "tension kN", late=True),
+    Q("min_link_tension", "min_link_tension", "peak", "kN", 1e3, "min link tension", None, late=True,
+      summary=False),
+    Q("peak_chassis_ay", "peak_chassis_ay", "peak", "m/s^2", 1.0, "peak chassis vertical acceleration", "ay max",
+      late=True),
+    Q("min_chassis_ay", "min_chassis_ay", "peak", "m/s^2", 1.0, "min chassis vertical acceleration", "ay min",
+      late=True),
+    Q("min_chassis_vx", "min_chassis_vx", "peak", "m/s", 1.0, "min chassis speed", "vx min", late=True),
+    Q("first_contact_time", "first_contact_time", "event", "s", 1.0, "first obstacle contact", None, late=False),
+    Q("first_compression_time", "first_compression_time", "event", "s", 1.0, "first link compression", "compr s",
+      late=False),
+    # whole-run maxima: set by a few contact switches that the chaotic motion places
+    Q("max_energy_balance_error", "max_energy_balance_error", "check", "1", 1.0, "energy balance error", None,
+      late=True),
+    Q("max_energy_residual", "max_energy_residual", "check", "1", 1.0, "work residual", None, late=True),
+)
+del Q
+BY_NAME = {q.variable: q for q in TABLE}
+SUMMARY = tuple(q for q in TABLE if q.summary)
+PEAKS = tuple(q for q in SUMMARY if q.kind == "peak")
+
+
+def summary_columns(n_wheels, times=True):
+    """The summary's result columns in order: each peak with its _time, then the rest."""
+    out = []
+    for q in SUMMARY:
+        for c in q.columns(n_wheels):
+            out += [c, c + "_time"] if times and q.kind == "peak" else [c]
+    return out
+
+
+def peak_columns(n_wheels):
+    """The peaks' columns (those with replicate statistics)."""
+    return [c for q in PEAKS for c in q.columns(n_wheels)]
+
+
+def quantity_of(column):
+    """(quantity, wheel or None) of a summary column or of a peak's _time companion, else None."""
+    for q in SUMMARY:
+        if column == q.name or q.wheel_of(column) is not None:
+            return q, q.wheel_of(column)
+    if column.endswith("_time"):
+        found = quantity_of(column[:-len("_time")])
+        if found and found[0].kind == "peak":
+            return found
+    return None
+
+
+def entries(ds):
+    """(quantity, column, SI value, time or None) of a run's Dataset, in table order; plain
+    floats, NaN kept (a run without a link compression has no first_compression_time)."""
+    for q in SUMMARY:
+        v = ds[q.variable]
+        t = ds[q.variable + "_time"] if q.kind == "peak" else None
+        if q.per_wheel:
+            for k, w in enumerate(ds["wheel"].values):
+                yield q, q.name.format(int(w)), float(v.values[k]), None if t is None else float(t.values[k])
+        else:
+            yield q, q.name, float(v), None if t is None else float(t)
+
+
+def values(ds, times=True):
+    """column -> SI value of a run's summary quantities; with times, each peak's time as
+    ``<column>_time`` after it (the order of summary_columns)."""
+    out = {}
+    for _, column, value, t in entries(ds):
+        out[column] = value
+        if times and t is not None:
+            out[column + "_time"] = t
+    return out
+
+
+def without_nan(d):
+    """NaN -> None (JSON null) in a dict of numbers."""
+    return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
