@@ -36,3 +36,18 @@ def test_no_damping_is_elastic_and_force_never_pulls():
     assert drop("none") == pytest.approx(1.0, abs=1e-6)
     # a strongly damped viscous contact would pull on the way out; it lets go instead
     assert drop("viscous", zeta=0.9, ramp=1e-9) > 0.0
+
+
+@pytest.mark.parametrize("k", [1e8, 3.16e9])
+def test_power_law_vehicle_starts_from_equilibrium(k):
+    """A power law has no stiffness at zero compression, where the equilibrium's Newton
+    iteration starts: it is reached by continuation from the linear law."""
+    from trackbench.simulate import equilibrium
+    sc = tb.Scenario.paper(**{"contact.law": "power", "contact.exponent": 1.5, "track.wheel_stiffness": k,
+                              "track.ground_stiffness": k})
+    eq = equilibrium(sc)
+    assert eq.residual < 1e-6 * eq.weight
+    assert eq.ground_force == pytest.approx(eq.weight, rel=1e-9)
+    # softer pads than the paper's at these loads (compressions of 0.5-5 mm instead of 0.4 mm)
+    linear = equilibrium(tb.Scenario.paper())
+    assert eq.q[1] < linear.q[1]   # the chassis sits lower

@@ -6,7 +6,7 @@ import pytest
 from trackbench.model import layout as L
 from trackbench.model.bundles import arm_table, model_arrays, work_arrays
 from trackbench.model.kernels import track_loads
-from trackbench.model.parameters import pack, paper_track, paper_vehicle
+from trackbench.model.parameters import pack, paper_contact, paper_track, paper_vehicle
 from trackbench.model.terrain import ground_from_points
 from trackbench.status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 
@@ -15,7 +15,7 @@ RHO = 0.30       # wheel radius 0.28 + pad 0.02
 HG = 0.02
 
 
-def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None):
+def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None, geometry="paper"):
     """Run the shared kernel on a hand-made configuration."""
     pins = np.array(pins, float)
     wheels = np.array(wheels, float).reshape(-1, 2)
@@ -23,7 +23,7 @@ def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None):
     v["n_wheels"] = len(wheels)
     tr = paper_track()
     tr["n_links"] = len(pins) - 1
-    par, piv, ends = pack(v, tr, 9.81)
+    par, piv, ends = pack(v, tr, 9.81, {**paper_contact(), "geometry": geometry})
     g = ground_from_points(ground)
     m = model_arrays(par, arm_table(piv, 0.0, 0.0), ends, g.segments, g.corners, len(pins) - 1)
     w = work_arrays(m, len(wheels), len(pins) - 1)

@@ -78,7 +78,8 @@ def test_restitution_laws_on_the_vehicle(law):
     ({"vehicle.arm_damping": [100.0, -1.0, 0.0, 0.0, 0.0]}, "vehicle.arm_damping[1]"),
     ({"preset": "soft"}, "preset"),
     ({"preset": "damped", "solver": "lee"}, "solver = 'lee'"),
-    ({"contact.geometry": "continuous"}, "contact.geometry"),
+    ({"contact.geometry": "smooth"}, "contact.geometry"),
+    ({"contact.geometry": "continuous", "solver": "lee"}, "contact.geometry"),
 ])
 def test_bad_damping_input_is_one_line(bad, words):
     with pytest.raises(ScenarioError) as e:

@@ -12,34 +12,55 @@ from trackbench.model import layout as L
 from trackbench.model.kinematics import place
 from trackbench.model.reduced import reduced_rhs
 from trackbench.simulate import Model, build_ground, equilibrium
+from trackbench.model.contact_laws import GEOMETRY_CONTINUOUS
+from trackbench.model.gaps import pin_cap_weight
 from trackbench.solvers.events import _gap_end
 
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
 
 
+def _weight(kind, i, b, m, pins, wheels, continuous):
+    """How often the pair counts: a pin's cap by gaps.pin_cap_weight; in the continuous
+    geometry a pin meets the ground once (every candidate segment gives the same gap)."""
+    if kind == L.K_PIN_GROUND:
+        return 1 if not continuous or b == m.nbr[m.nbr_rows[kind] + i, 1] else 0
+    if kind not in (L.K_WHEEL_PIN, L.K_CORNER_PIN):
+        return 1
+    p = wheels[i] if kind == L.K_WHEEL_PIN else m.corners[i]
+    t0 = (pins[b] - pins[b - 1]) / np.linalg.norm(pins[b] - pins[b - 1])
+    t1 = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
+    return pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1], kind == L.K_WHEEL_PIN,
+                          continuous)
+
+
 def _event_energy(m, w, par):
-    """Pad energies (wheel side, ground side) over the pairs the event location calls active."""
+    """Pad energies (wheel side, ground side) over the pairs the event location calls
+    active, each as often as it counts (_weight)."""
     place_pins, place_wheels = w.apos.copy(), w.wc.copy()
+    continuous = par[L.P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     energy = {"wheel": 0.0, "ground": 0.0}
     for kind in range(L.N_KINDS):
         k = par[L.P_K_GROUND] if kind in GROUND_KINDS else par[L.P_K_WHEEL]
         for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
+            i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, L.NB_COUNT]):
-                valid, gap = _gap_end(kind, row - m.nbr_rows[kind], m.nbr[row, 1 + j], place_pins, place_wheels, m)
+                b = m.nbr[row, 1 + j]
+                valid, gap = _gap_end(kind, i, b, place_pins, place_wheels, m)
                 if valid and gap > 0.0:
-                    energy["ground" if kind in GROUND_KINDS else "wheel"] += 0.5 * k * gap * gap
+                    weight = _weight(kind, i, b, m, place_pins, place_wheels, continuous)
+                    energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
     return energy
 
 
-@pytest.fixture(scope="module")
-def model():
-    sc = tb.Scenario.paper()
+def _model(sc):
     eq = equilibrium(sc)
     return Model(sc, eq, build_ground(sc, eq)[0])
 
 
-def test_event_contact_decision_equals_the_kernels(paper_run, model):
-    ds = paper_run
+@pytest.mark.parametrize("geometry", ["paper", "continuous"])
+def test_event_contact_decision_equals_the_kernels(geometry, request):
+    ds = request.getfixturevalue("paper_run" if geometry == "paper" else "continuous_run")
+    model = _model(tb.Scenario.paper(**{"contact.geometry": geometry}))
     m, w = model.arrays, model.work
     nq = L.n_coordinates(model.nw, model.n_links)
     off = L.pin_offset(model.nw)

@@ -13,13 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model.contact_laws import DAMPINGS, LAWS
+from .model.contact_laws import DAMPINGS, GEOMETRIES, LAWS
 
 from .model.parameters import GRAVITY, paper_contact, paper_track, paper_vehicle, wheel_centres_body
 from .presets import PRESETS, preset_values
 
 SOLVERS = ("reduced", "lee")
-GEOMETRIES = ("paper",)
 METHODS = ("dop853", "dopri5")
 TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
 OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
@@ -102,7 +101,7 @@ RULES = {
     "contact.restitution": (float, 0.0, 1.0, "a number in (0, 1]"),
     "contact.damping_ramp": (float, 0.0, 0.1, "a number in (0, 0.1] m"),
     "contact.min_approach_speed": (float, 0.0, 100.0, "a number in (0, 100] m/s"),
-    "contact.geometry": (str, GEOMETRIES, None, "one of " + ", ".join(GEOMETRIES)),
+    "contact.geometry": (str, tuple(GEOMETRIES), None, "one of " + ", ".join(GEOMETRIES)),
     "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),

@@ -34,6 +34,11 @@ DAMPING_FLORES = 4
 DAMPINGS = {"none": DAMPING_NONE, "viscous": DAMPING_VISCOUS, "hunt_crossley": DAMPING_HUNT_CROSSLEY,
             "lankarani_nikravesh": DAMPING_LANKARANI_NIKRAVESH, "flores": DAMPING_FLORES}
 
+# contact.geometry: how a wheel or a ground corner meets the track near a pin
+GEOMETRY_PAPER = 0        # model.md: a link where the foot lies on it, else the pin in the convex wedge
+GEOMETRY_CONTINUOUS = 1   # the union of link pads with round caps at the pins (gaps.pin_cap_weight)
+GEOMETRIES = {"paper": GEOMETRY_PAPER, "continuous": GEOMETRY_CONTINUOUS}
+
 
 def restitution_factor(damping, e):
     """The factor chi of F = K d^n (1 + chi d'/v0) for a restitution-based law."""

@@ -178,20 +178,11 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     return fx
 
 
-def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_iter=60):
-    """Newton iteration with a finite-difference Jacobian and a backtracking line search."""
-    P = _Problem(vehicle, track, gravity, contact)
-    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
-    hg = P.par[L.P_PAD_GROUND]
-    # start: wheels resting on the track, the track on the ground, chassis level
-    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
-    yc = -wcb[:, 1].min() + rho + hg
-    ends_w = P.ends + [0.0, yc]
-    pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
-    u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
+def _newton(P, u, target, max_iter):
+    """Newton iteration with a finite-difference Jacobian and a backtracking line search;
+    returns (u, residual norm, iterations)."""
     r, _, _ = P.residual(u)
     norm = np.abs(r).max()
-    target = tol_rel * P.weight
     it = 0
     while norm > target and it < max_iter:
         it += 1
@@ -204,9 +195,47 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_
             if nn < norm or lam < 1e-4:
                 break
             lam *= 0.5
-        u, r, norm = un, rn, nn
-        if lam < 1e-4 and nn >= norm:
+        if nn >= norm:   # no descent even for a tiny step: stuck
             break
+        u, r, norm = un, rn, nn
+    return u, norm, it
+
+
+def _continuation(P, u, target, max_iter, step=0.05):
+    """Newton's method, for a power law F = k delta^n (no stiffness at zero compression,
+    where Newton's method starts) through a chain of laws k d^(n - m) delta^m, m from 1 to
+    n, each solution starting the next: d, a wheel's compression under an equal share of
+    the weight, keeps the forces of every law of the chain alike."""
+    n = P.par[L.P_CONTACT_EXPONENT]
+    if n == 1.0:
+        return _newton(P, u, target, max_iter)
+    kw, kg = P.par[L.P_K_WHEEL], P.par[L.P_K_GROUND]
+    d = (P.weight / (P.nw * kw)) ** (1.0 / n)
+    it = 0
+    for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
+        P.par[L.P_CONTACT_EXPONENT] = m
+        P.par[L.P_K_WHEEL] = kw * d ** (n - m)
+        P.par[L.P_K_GROUND] = kg * d ** (n - m)
+        u, norm, k = _newton(P, u, target if m == n else 1e-6 * P.weight, max_iter)
+        it += k
+    P.par[L.P_K_WHEEL], P.par[L.P_K_GROUND] = kw, kg   # exactly the scenario's law again
+    return u, norm, it
+
+
+def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_iter=60):
+    """Newton's method from the wheels resting on the track and the track on the ground.
+    A power law is reached by continuation (_continuation)."""
+    P = _Problem(vehicle, track, gravity, contact)
+    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
+    hg = P.par[L.P_PAD_GROUND]
+    # start: wheels resting on the track, the track on the ground, chassis level
+    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
+    yc = -wcb[:, 1].min() + rho + hg
+    ends_w = P.ends + [0.0, yc]
+    pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
+    u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
+    target = tol_rel * P.weight
+    u, norm, it = _continuation(P, u, target, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
         raise EquilibriumError(
             f"static equilibrium not found: force residual {norm:.3g} N after {it} Newton "

@@ -69,6 +69,38 @@ def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
 
 
 @njit(**INLINE)
+def pin_cap_weight(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner, continuous):
+    """How many times the round cap of the free pin A (between a link along t0 ending at A
+    and one along t1 starting at A) acts on P.
+    Paper geometry: once in the convex wedge (wedge), else never.
+    Continuous geometry: the pad surface is the union of the two links' pads, each a
+    link with round caps at its pins; by inclusion-exclusion the cap counts once for
+    each link whose foot test P fails towards A (P on that link's contact side), less
+    once where P is on the contact side of both links (the caps overlap). The result is
+    1 in the convex wedge (the paper's pin contact), 0 where P's foot lies on one link
+    and not the other (the paper's link contact), -1 where it lies on both (a concave
+    bend: the two links' terms overlap there). Every term is continuous in P and the
+    pins, so the contact energy is too: no jump from link to pin."""
+    if not continuous:
+        return 1 if wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner) else 0
+    dx = px - ax
+    dy = py - ay
+    side0 = dx * t0y - dy * t0x    # along the inner normal of each link
+    side1 = dx * t1y - dy * t1x
+    if not towards_inner:
+        side0 = -side0
+        side1 = -side1
+    weight = 0
+    if side0 > 0.0 and dx * t0x + dy * t0y > 0.0:
+        weight += 1
+    if side1 > 0.0 and dx * t1x + dy * t1y < 0.0:
+        weight += 1
+    if side0 > 0.0 and side1 > 0.0:
+        weight -= 1
+    return weight
+
+
+@njit(**INLINE)
 def point_on_segment(px, py, x0, y0, tx, ty, nx, ny):
     """(lam, s) of point P against a ground segment from (x0, y0) along t with outward
     normal n: lam along it (the foot lies on it when 0 <= lam <= length), s along n."""
@@ -125,3 +157,36 @@ def pin_segment_valid(lam, s, length, inside, n_below, best):
     if s < 0.0 and not inside:
         return False
     return not (n_below >= 2 and s < best)
+
+
+@njit(**INLINE)
+def ground_distance(px, py, seg, nbr, row):
+    """Continuous geometry: (s, nx, ny, j) of P against the ground - s the signed distance
+    to the nearest point of the ground's surface among the candidate segments in row
+    (negative inside the ground), (nx, ny) the unit direction in which s grows, j the
+    segment of that nearest point. Beyond a segment's end the nearest point is the end
+    itself (a round cap at a convex corner), so s is continuous in P everywhere: the
+    one distance replaces the paper's per-segment cases and its nearest-segment rule."""
+    best = np.inf
+    ux = 0.0
+    uy = 1.0
+    near = -1
+    inside = False
+    for j in range(nbr[row, NB_COUNT]):
+        sj = nbr[row, 1 + j]
+        lam, s, dx = segment_coords(px, py, seg, sj)
+        length = seg[sj, SEG_LENGTH]
+        if s < 0.0 and seg[sj, SEG_TX] > 0.0 and 0.0 <= dx <= length * seg[sj, SEG_TX]:
+            inside = True
+        lam = min(max(lam, 0.0), length)
+        qx = px - seg[sj, SEG_X0] - lam * seg[sj, SEG_TX]    # P minus its nearest point on sj
+        qy = py - seg[sj, SEG_Y0] - lam * seg[sj, SEG_TY]
+        d = math.sqrt(qx * qx + qy * qy)
+        if d < best and d > 0.0:
+            best = d
+            ux = qx / d
+            uy = qy / d
+            near = sj
+    if inside:
+        return -best, -ux, -uy, near
+    return best, ux, uy, near

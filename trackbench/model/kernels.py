@@ -14,14 +14,14 @@ import numpy as np
 from numba import njit
 
 from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
-from .gaps import (link_frames, pin_ground_selection, pin_segment_valid, point_on_link, point_on_segment,
-                   segment_coords, wedge)
+from .gaps import (ground_distance, link_frames, pin_cap_weight, pin_ground_selection, pin_segment_valid, point_on_link,
+                   point_on_segment, segment_coords)
 from .contact_force import normal_force
-from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, LAW_LINEAR
+from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
-    C_EVALUATIONS, D_DISSIPATION, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
+    C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 
 
@@ -214,6 +214,7 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
     k = law[2]
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped    # the paper's spring: no call
+    continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
     r0 = rows[K_WHEEL_LINK]
     r1 = rows[K_WHEEL_PIN]
@@ -250,8 +251,9 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
         row = r1 + i
         for j in range(nbr[row, NB_COUNT]):
             b = nbr[row, 1 + j]
-            if not wedge(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1],
-                         True):
+            weight = pin_cap_weight(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0],
+                                    lk[b, 1], True, continuous)
+            if weight == 0:
                 continue
             dx = wc[i, 0] - apos[b, 0]
             dy = wc[i, 1] - apos[b, 1]
@@ -263,6 +265,8 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
             else:
                 rate = -(dx * (wv[i, 0] - avel[b, 0]) + dy * (wv[i, 1] - avel[b, 1])) / dist if damped else 0.0
                 p, e, pd = law_force(law, rho - dist, rate, mem, row, b)
+            if weight != 1:
+                p, e, pd = weight * p, weight * e, weight * pd
             fx = p * dx / dist
             fy = p * dy / dist
             fwx += fx
@@ -284,35 +288,49 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
 @njit(**INLINE)
 def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
-    a pin is beyond several (gaps.pin_ground_selection). acc = (fx, fy, corner force,
-    energy, power, obstacle force, dissipation), carried through in the order of one
-    loop. Every segment after the first (the ground the vehicle starts on) belongs to an
-    obstacle."""
+    a pin is beyond several (gaps.pin_ground_selection); in the continuous geometry one
+    contact per pin with the ground's nearest point (gaps.ground_distance). acc = (fx,
+    fy, corner force, energy, power, obstacle force, dissipation), carried through in
+    the order of one loop. Every segment after the first (the ground the vehicle starts
+    on) belongs to an obstacle."""
     law = contact_law(par, P_C_GROUND)
     k = law[2]
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
+    continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, apos.shape[0] - 1):
         row = first + b
-        inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, nbr, row, hg)
-        if best == -np.inf:
-            continue
-        for j in range(nbr[row, NB_COUNT]):
-            sj = nbr[row, 1 + j]
-            lam, s = point_on_segment(apos[b, 0], apos[b, 1], seg[sj, SEG_X0], seg[sj, SEG_Y0], seg[sj, SEG_TX],
-                                      seg[sj, SEG_TY], seg[sj, SEG_NX], seg[sj, SEG_NY])
-            if s >= hg or not pin_segment_valid(lam, s, seg[sj, SEG_LENGTH], inside, n_below, best):
+        if continuous:
+            inside, n_below, best = False, 0, 0.0
+        else:
+            inside, n_below, best = pin_ground_selection(apos[b, 0], apos[b, 1], seg, nbr, row, hg)
+            if best == -np.inf:
+                continue
+        for j in range(1 if continuous else nbr[row, NB_COUNT]):
+            if continuous:   # one contact: its memory (law_force) under partner 0
+                s, nx, ny, sj = ground_distance(apos[b, 0], apos[b, 1], seg, nbr, row)
+                partner = 0
+            else:
+                sj = nbr[row, 1 + j]
+                partner = sj
+                nx = seg[sj, SEG_NX]
+                ny = seg[sj, SEG_NY]
+                lam, s = point_on_segment(apos[b, 0], apos[b, 1], seg[sj, SEG_X0], seg[sj, SEG_Y0], seg[sj, SEG_TX],
+                                          seg[sj, SEG_TY], nx, ny)
+                if s < hg and not pin_segment_valid(lam, s, seg[sj, SEG_LENGTH], inside, n_below, best):
+                    continue
+            if s >= hg:
                 continue
             if plain:
                 p, e, pd = k * (hg - s), 0.5 * k * (hg - s) ** 2, 0.0  # Eq. (6)
             else:
-                rate = -(avel[b, 0] * seg[sj, SEG_NX] + avel[b, 1] * seg[sj, SEG_NY]) if damped else 0.0
-                p, e, pd = law_force(law, hg - s, rate, mem, row, sj)
-            fx = p * seg[sj, SEG_NX]
-            fy = p * seg[sj, SEG_NY]
+                rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
+                p, e, pd = law_force(law, hg - s, rate, mem, row, partner)
+            fx = p * nx
+            fy = p * ny
             fpin[b, 0] += fx
             fpin[b, 1] += fy
             gx += fx
@@ -334,6 +352,7 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
     hg = par[P_PAD_GROUND]
+    continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     r_link = rows[K_CORNER_LINK]
     r_pin = rows[K_CORNER_PIN]
     hw = par[P_PAD_WHEEL]
@@ -366,7 +385,9 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
             obstacle += p
         for j in range(nbr[r_pin + c, NB_COUNT]):
             b = nbr[r_pin + c, 1 + j]
-            if not wedge(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1], False):
+            weight = pin_cap_weight(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1],
+                                    False, continuous)
+            if weight == 0:
                 continue
             dx = cx - apos[b, 0]
             dy = cy - apos[b, 1]
@@ -378,6 +399,8 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
             else:
                 rate = (dx * avel[b, 0] + dy * avel[b, 1]) / dist if damped else 0.0
                 p, e, pd = law_force(law, hg - dist, rate, mem, r_pin + c, b)
+            if weight != 1:
+                p, e, pd = weight * p, weight * e, weight * pd
             fx = -p * dx / dist
             fy = -p * dy / dist
             fpin[b, 0] += fx

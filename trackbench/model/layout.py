@@ -159,7 +159,8 @@ P_RESTITUTION_FACTOR = 21  # chi of the restitution-based laws
 P_DAMPING_RAMP = 22      # d_r (m)
 P_MIN_APPROACH = 23      # approach speed below which v0 counts as this (m/s)
 P_LINK_DAMPING = 24      # axial dashpot of every link (N s/m)
-N_PAR = 25
+P_CONTACT_GEOMETRY = 25   # GEOMETRY_* code (contact_laws.py)
+N_PAR = 26
 
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point

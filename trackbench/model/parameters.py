@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from . import layout as L
-from .contact_laws import DAMPING_VISCOUS, DAMPINGS, LAWS, restitution_factor
+from .contact_laws import DAMPING_VISCOUS, DAMPINGS, GEOMETRIES, LAWS, restitution_factor
 
 
 def paper_vehicle():
@@ -98,6 +98,7 @@ def _pack_contact(par, contact):
     par[L.P_RESTITUTION_FACTOR] = restitution_factor(damping, contact["restitution"])
     par[L.P_DAMPING_RAMP] = contact["damping_ramp"]
     par[L.P_MIN_APPROACH] = contact["min_approach_speed"]
+    par[L.P_CONTACT_GEOMETRY] = GEOMETRIES[contact["geometry"]]
 
 
 def pack(vehicle, track, gravity, contact=None):

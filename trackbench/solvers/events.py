@@ -17,14 +17,14 @@ import math
 
 from numba import njit
 
-from ..model.gaps import (link_frame, pin_ground_selection, pin_segment_valid, point_on_link,
-                          segment_coords, wedge)
-from ..model.contact_laws import DAMPING_VISCOUS
+from ..model.gaps import (ground_distance, link_frame, pin_cap_weight, pin_ground_selection, pin_segment_valid, point_on_link,
+                          segment_coords)
+from ..model.contact_laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.index import nq_of, q_pin
 from ..model.layout import (
-    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
 )
 from .hermite import coordinate, quintic_basis
 
@@ -60,9 +60,11 @@ def _reach(kind, par):
 
 
 @njit(**INLINE)
-def _pair(kind, p, a, bb, c, reach):
-    """(valid, reach - s) of point p against the link a -> bb (link kinds) or against pin a
-    in the wedge after the link c -> a (pin kinds); points are (x, y) tuples."""
+def _pair(kind, p, a, bb, c, par):
+    """(valid, reach - s) of point p against the link a -> bb (link kinds) or against the
+    cap of pin a after the link c -> a where it acts (pin kinds, gaps.pin_cap_weight);
+    points are (x, y) tuples."""
+    reach = _reach(kind, par)
     tx, ty, length = link_frame(a[0], a[1], bb[0], bb[1])
     if kind == K_WHEEL_LINK or kind == K_CORNER_LINK:
         d0, s = point_on_link(p[0], p[1], a[0], a[1], tx, ty)
@@ -72,13 +74,17 @@ def _pair(kind, p, a, bb, c, reach):
     ux, uy, _ = link_frame(c[0], c[1], a[0], a[1])
     dx = p[0] - a[0]
     dy = p[1] - a[1]
-    return wedge(p[0], p[1], a[0], a[1], ux, uy, tx, ty, kind == K_WHEEL_PIN), reach - math.sqrt(dx * dx + dy * dy)
+    weight = pin_cap_weight(p[0], p[1], a[0], a[1], ux, uy, tx, ty, kind == K_WHEEL_PIN,
+                            par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS)
+    return weight != 0, reach - math.sqrt(dx * dx + dy * dy)
 
 
 @njit(**INLINE)
 def _pin_ground(px, py, sj, m, row):
     """(valid, h_g - s) of a pin at P on segment sj, by the kernel's selection rule."""
     hg = m.par[P_PAD_GROUND]
+    if m.par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS:   # one contact with the nearest point
+        return True, hg - ground_distance(px, py, m.seg, m.nbr, row)[0]
     inside, n_below, best = pin_ground_selection(px, py, m.seg, m.nbr, row, hg)
     lam, s, _ = segment_coords(px, py, m.seg, sj)
     return pin_segment_valid(lam, s, m.seg[sj, SEG_LENGTH], inside, n_below, best), hg - s
@@ -101,7 +107,7 @@ def _gap_at(kind, i, b, t, step, nq, m, n_links):
     c = a
     if kind == K_WHEEL_PIN or kind == K_CORNER_PIN:
         c = _pin_at(b - 1, w, step, nq, m, n_links)
-    return _pair(kind, p, a, bb, c, _reach(kind, m.par))
+    return _pair(kind, p, a, bb, c, m.par)
 
 
 @njit(**INLINE)
@@ -115,7 +121,7 @@ def _gap_end(kind, i, b, pins, wheels, m):
         p = (m.corners[i, 0], m.corners[i, 1])
     bp = b - 1 if (kind == K_WHEEL_PIN or kind == K_CORNER_PIN) else b
     return _pair(kind, p, (pins[b, 0], pins[b, 1]), (pins[b + 1, 0], pins[b + 1, 1]), (pins[bp, 0], pins[bp, 1]),
-                 _reach(kind, m.par))
+                 m.par)
 
 
 @njit(**BORROW)
