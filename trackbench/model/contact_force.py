@@ -4,10 +4,10 @@ formulas, their sources and the codes)."""
 from numba import njit
 
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, LAW_POWER
-from .jit import INLINE
+from .jit import SCALAR
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def elastic(law, k, n, delta):
     """(force, stored energy) of the pad spring at compression delta > 0."""
     if law == LAW_POWER:
@@ -16,7 +16,7 @@ def elastic(law, k, n, delta):
     return k * delta, 0.5 * k * delta ** 2
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def normal_force(law, delta, delta_dot, v0):
     """(force, stored energy, dissipated power) of one contact at compression delta > 0
     closing at delta_dot, v0 its approach speed at onset. law = (elastic law code, damping

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .jit import INLINE
+from .jit import BORROW, INLINE, SCALAR
 from .layout import NB_COUNT, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0
 
 
@@ -33,7 +33,7 @@ def link_frames(apos, lk):
         lk[b, 1] = lk[b, 1] * inv
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def link_frame(ax, ay, bx, by):
     """(tx, ty, length) of the link from pin A to pin B, rounded as link_frames does."""
     dx = bx - ax
@@ -43,7 +43,7 @@ def link_frame(ax, ay, bx, by):
     return dx * inv, dy * inv, length
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def point_on_link(px, py, ax, ay, tx, ty):
     """(d0, s) of point P against the link from pin A along t: d0 along the link (the foot
     lies on the link when 0 <= d0 <= length), s the distance along the inner normal, Eq. (2)."""
@@ -52,7 +52,7 @@ def point_on_link(px, py, ax, ay, tx, ty):
     return dx * tx + dy * ty, dx * ty - dy * tx
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
     """P lies in the wedge beyond the free pin A between a link along t0 (ending at A) and
     one along t1 (starting at A) - both fail the foot test - on the convex side of the
@@ -68,7 +68,7 @@ def wedge(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner):
     return turn > 0.0 if towards_inner else turn < 0.0
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def pin_cap_weight(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner, continuous):
     """How many times the round cap of the free pin A (between a link along t0 ending at A
     and one along t1 starting at A) acts on P.
@@ -100,7 +100,7 @@ def pin_cap_weight(px, py, ax, ay, t0x, t0y, t1x, t1y, towards_inner, continuous
     return weight
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def point_on_segment(px, py, x0, y0, tx, ty, nx, ny):
     """(lam, s) of point P against a ground segment from (x0, y0) along t with outward
     normal n: lam along it (the foot lies on it when 0 <= lam <= length), s along n."""
@@ -147,7 +147,7 @@ def pin_ground_selection(px, py, seg, nbr, row, hg):
     return True, n_below, best
 
 
-@njit(**INLINE)
+@njit(**SCALAR)
 def pin_segment_valid(lam, s, length, inside, n_below, best):
     """May a segment of this length push the pin at (lam, s) (foot on it, on the right
     side, the nearest of several it is behind; pin_ground_selection gives inside,
@@ -159,7 +159,7 @@ def pin_segment_valid(lam, s, length, inside, n_below, best):
     return not (n_below >= 2 and s < best)
 
 
-@njit(**INLINE)
+@njit(**BORROW)
 def ground_distance(px, py, seg, nbr, row):
     """Continuous geometry: (s, nx, ny, j) of P against the ground - s the signed distance
     to the nearest point of the ground's surface among the candidate segments in row

@@ -13,6 +13,9 @@ rounds alike and a run is reproducible bit for bit.
 
 KERNEL = {"cache": True, "error_model": "numpy"}
 INLINE = dict(KERNEL, inline="always")
+# Small functions of scalars (and of an array read or two): LLVM inlines them where they
+# pay, and inlining them at numba-IR level as well only costs compile time.
+SCALAR = KERNEL
 
 # The solver loops and the right-hand sides never allocate: every array they touch is
 # allocated and held by the Python side for the whole run. Their bundles (named tuples of

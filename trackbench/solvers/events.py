@@ -90,7 +90,7 @@ def _pin_ground(px, py, sj, m, row):
     return pin_segment_valid(lam, s, m.seg[sj, SEG_LENGTH], inside, n_below, best), hg - s
 
 
-@njit(**INLINE)
+@njit(**BORROW)   # called, not inlined: each inlined copy cost ~25 s of compile time
 def _gap_at(kind, i, b, t, step, nq, m, n_links):
     """(valid, gap) of one candidate pair at fraction t of the step: kind K_*, i the wheel
     or corner (the pin for K_PIN_GROUND), b the link or pin (the segment for K_PIN_GROUND)."""
