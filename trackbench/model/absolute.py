@@ -32,6 +32,8 @@ from .kernels import track_loads
 from .kinematics import body_offset, wheel_offset
 from .index import diag_tension, nq_of, pin_offset, z_arm, z_pin
 from .layout import (
+    ARMS_PX, ARMS_PY,
+    GEO_LX, GEO_LY, GEO_RX, GEO_RY, J_X, J_Y, LK_LENGTH, LK_TX, LK_TY, N_J_ROWS,
     ARMS_PHI0, D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH, Q_X, Q_Y, Y_DISSIPATED, Y_WORK, Z_PITCH, Z_X, Z_Y, ZA_BETA, ZA_X, ZA_Y, n_absolute,
 )
 
@@ -69,7 +71,7 @@ def from_reduced(y, par, arms, z, zd):
         cb = math.cos(beta)
         sb = math.sin(beta)
         rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
-        px, py = body_offset(c, s, arms[i, 0], arms[i, 1])   # the pivot
+        px, py = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])   # the pivot
         j = z_arm(i)
         z[j + ZA_X] = y[Q_X] + rx
         z[j + ZA_Y] = y[Q_Y] + ry
@@ -111,10 +113,10 @@ def joint_vectors(z, par, arms, geo):
     c = math.cos(z[Z_PITCH])
     s = math.sin(z[Z_PITCH])
     for i in range(arms.shape[0]):
-        geo[i, 0], geo[i, 1] = body_offset(c, s, arms[i, 0], arms[i, 1])
+        geo[i, GEO_RX], geo[i, GEO_RY] = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
         beta = z[z_arm(i) + ZA_BETA]
-        geo[i, 2] = la * math.cos(beta)
-        geo[i, 3] = la * math.sin(beta)
+        geo[i, GEO_LX] = la * math.cos(beta)
+        geo[i, GEO_LY] = la * math.sin(beta)
 
 
 @njit(**BORROW)
@@ -122,8 +124,8 @@ def phi(z, geo, out):
     """Position constraints Phi (Eq. 1), 2 per joint; geo from joint_vectors(z)."""
     for i in range(geo.shape[0]):
         j = z_arm(i)
-        out[2 * i] = z[Z_X] + geo[i, 0] - z[j + ZA_X] + geo[i, 2]
-        out[2 * i + 1] = z[Z_Y] + geo[i, 1] - z[j + ZA_Y] + geo[i, 3]
+        out[N_J_ROWS * i + J_X] = z[Z_X] + geo[i, GEO_RX] - z[j + ZA_X] + geo[i, GEO_LX]
+        out[N_J_ROWS * i + J_Y] = z[Z_Y] + geo[i, GEO_RY] - z[j + ZA_Y] + geo[i, GEO_LY]
 
 
 @njit(**BORROW)
@@ -131,8 +133,8 @@ def phi_q_times(geo, u, out):
     """out = Phi_q u (u: body part of a velocity or acceleration vector)."""
     for i in range(geo.shape[0]):
         j = z_arm(i)
-        out[2 * i] = u[Z_X] - geo[i, 1] * u[Z_PITCH] - u[j + ZA_X] - geo[i, 3] * u[j + ZA_BETA]
-        out[2 * i + 1] = u[Z_Y] + geo[i, 0] * u[Z_PITCH] - u[j + ZA_Y] + geo[i, 2] * u[j + ZA_BETA]
+        out[N_J_ROWS * i + J_X] = u[Z_X] - geo[i, GEO_RY] * u[Z_PITCH] - u[j + ZA_X] - geo[i, GEO_LY] * u[j + ZA_BETA]
+        out[N_J_ROWS * i + J_Y] = u[Z_Y] + geo[i, GEO_RX] * u[Z_PITCH] - u[j + ZA_Y] + geo[i, GEO_LX] * u[j + ZA_BETA]
 
 
 @njit(**BORROW)
@@ -140,14 +142,14 @@ def add_phi_qt(geo, lam, scale, out):
     """out += scale * Phi_q^T lambda (body components only)."""
     for i in range(geo.shape[0]):
         j = z_arm(i)
-        lx = scale * lam[2 * i]
-        ly = scale * lam[2 * i + 1]
+        lx = scale * lam[N_J_ROWS * i + J_X]
+        ly = scale * lam[N_J_ROWS * i + J_Y]
         out[Z_X] += lx
         out[Z_Y] += ly
-        out[Z_PITCH] += -geo[i, 1] * lx + geo[i, 0] * ly
+        out[Z_PITCH] += -geo[i, GEO_RY] * lx + geo[i, GEO_RX] * ly
         out[j + ZA_X] -= lx
         out[j + ZA_Y] -= ly
-        out[j + ZA_BETA] += -geo[i, 3] * lx + geo[i, 2] * ly
+        out[j + ZA_BETA] += -geo[i, GEO_LY] * lx + geo[i, GEO_LX] * ly
 
 
 @njit(**BORROW)
@@ -157,8 +159,8 @@ def gamma(zd, geo, out):
     w2 = zd[Z_PITCH] * zd[Z_PITCH]
     for i in range(geo.shape[0]):
         b2 = zd[z_arm(i) + ZA_BETA] ** 2
-        out[2 * i] = w2 * geo[i, 0] + b2 * geo[i, 2]
-        out[2 * i + 1] = w2 * geo[i, 1] + b2 * geo[i, 3]
+        out[N_J_ROWS * i + J_X] = w2 * geo[i, GEO_RX] + b2 * geo[i, GEO_LX]
+        out[N_J_ROWS * i + J_Y] = w2 * geo[i, GEO_RY] + b2 * geo[i, GEO_LY]
 
 
 @njit(**BORROW)
@@ -168,21 +170,21 @@ def constraint_matrix(geo, minv, G):
     mc = minv[Z_X]
     ic = minv[Z_PITCH]
     for i in range(nw):
-        ai = (-geo[i, 1], geo[i, 0])
+        ai = (-geo[i, GEO_RY], geo[i, GEO_RX])
         for j in range(nw):
-            aj = (-geo[j, 1], geo[j, 0])
-            for r in range(2):
-                for k in range(2):
+            aj = (-geo[j, GEO_RY], geo[j, GEO_RX])
+            for r in range(N_J_ROWS):
+                for k in range(N_J_ROWS):
                     v = ic * ai[r] * aj[k]
                     if r == k:
                         v += mc
-                    G[2 * i + r, 2 * j + k] = v
+                    G[N_J_ROWS * i + r, N_J_ROWS * j + k] = v
         ma = minv[z_arm(i) + ZA_X]
         ia = minv[z_arm(i) + ZA_BETA]
-        si = (-geo[i, 3], geo[i, 2])
-        for r in range(2):
-            for k in range(2):
-                G[2 * i + r, 2 * i + k] += ia * si[r] * si[k] + (ma if r == k else 0.0)
+        si = (-geo[i, GEO_LY], geo[i, GEO_LX])
+        for r in range(N_J_ROWS):
+            for k in range(N_J_ROWS):
+                G[N_J_ROWS * i + r, N_J_ROWS * i + k] += ia * si[r] * si[k] + (ma if r == k else 0.0)
 
 
 @njit(**INLINE)
@@ -223,10 +225,10 @@ def _contact_only(fpin, lk, diag, t_off, fc):
         fc[b, 1] = fpin[b, 1]
     for b in range(n_pins - 1):
         tn = diag[t_off + b]
-        fc[b, 0] -= tn * lk[b, 0]
-        fc[b, 1] -= tn * lk[b, 1]
-        fc[b + 1, 0] += tn * lk[b, 0]
-        fc[b + 1, 1] += tn * lk[b, 1]
+        fc[b, 0] -= tn * lk[b, LK_TX]
+        fc[b, 1] -= tn * lk[b, LK_TY]
+        fc[b + 1, 0] += tn * lk[b, LK_TX]
+        fc[b + 1, 1] += tn * lk[b, LK_TY]
 
 
 @njit(**BORROW)

@@ -71,17 +71,16 @@ def work_arrays(m, n_wheels, n_links):
     n_pins = n_links + 1
     return Work(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
                 np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
-                np.zeros((n_links, 3)), np.zeros((n_wheels, ARM_COLS)),
+                np.zeros((n_links, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
                 np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape))
 
 
 # Scratch of the event location (solvers/events.py): the configuration at both ends of
 # a rejected step.
-EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "lk0", "lk1", "arm"])
+EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "arm"])
 
 
 def event_arrays(n_wheels, n_links):
     n_pins = n_links + 1
     return EventWork(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_wheels, 2)),
-                     np.zeros((n_wheels, 2)), np.zeros((n_links, 3)), np.zeros((n_links, 3)),
-                     np.zeros((n_wheels, ARM_COLS)))
+                     np.zeros((n_wheels, 2)), np.zeros((n_wheels, ARM_COLS)))

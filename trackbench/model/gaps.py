@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from .jit import BORROW, INLINE, SCALAR
-from .layout import NB_COUNT, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0
+from .layout import LK_LENGTH, LK_TX, LK_TY, NB_COUNT, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0
 
 
 @njit(**INLINE)
@@ -24,13 +24,13 @@ def link_frames(apos, lk):
     for b in range(n_links):
         dx = apos[b + 1, 0] - apos[b, 0]
         dy = apos[b + 1, 1] - apos[b, 1]
-        lk[b, 0] = dx
-        lk[b, 1] = dy
-        lk[b, 2] = math.sqrt(dx * dx + dy * dy)
+        lk[b, LK_TX] = dx
+        lk[b, LK_TY] = dy
+        lk[b, LK_LENGTH] = math.sqrt(dx * dx + dy * dy)
     for b in range(n_links):
-        inv = 1.0 / lk[b, 2]
-        lk[b, 0] = lk[b, 0] * inv
-        lk[b, 1] = lk[b, 1] * inv
+        inv = 1.0 / lk[b, LK_LENGTH]
+        lk[b, LK_TX] = lk[b, LK_TX] * inv
+        lk[b, LK_TY] = lk[b, LK_TY] * inv
 
 
 @njit(**SCALAR)

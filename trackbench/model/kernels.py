@@ -21,6 +21,7 @@ from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUO
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
+    LK_LENGTH, LK_TX, LK_TY,
     C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 
@@ -132,9 +133,9 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     tmax = -np.inf
     link_frames(apos, lk)
     for b in range(apos.shape[0] - 1):
-        tx = lk[b, 0]
-        ty = lk[b, 1]
-        stretch = lk[b, 2] - l0
+        tx = lk[b, LK_TX]
+        ty = lk[b, LK_TY]
+        stretch = lk[b, LK_LENGTH] - l0
         tension = k * stretch
         if c != 0.0:
             rate = (avel[b + 1, 0] - avel[b, 0]) * tx + (avel[b + 1, 1] - avel[b, 1]) * ty
@@ -183,8 +184,8 @@ def _link_rate(vx, vy, avel, lk, b, d0):
     (v - a_b') . n_b + d0 omega_b, omega_b the link's rotation rate."""
     dvx = avel[b + 1, 0] - avel[b, 0]
     dvy = avel[b + 1, 1] - avel[b, 1]
-    omega = (lk[b, 0] * dvy - lk[b, 1] * dvx) / lk[b, 2]
-    return (vx - avel[b, 0]) * lk[b, 1] - (vy - avel[b, 1]) * lk[b, 0] + d0 * omega
+    omega = (lk[b, LK_TX] * dvy - lk[b, LK_TY] * dvx) / lk[b, LK_LENGTH]
+    return (vx - avel[b, 0]) * lk[b, LK_TY] - (vy - avel[b, 1]) * lk[b, LK_TX] + d0 * omega
 
 
 @njit(**BORROW)
@@ -227,8 +228,8 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
         row = r0 + i
         for j in range(nbr[row, NB_COUNT]):
             b = nbr[row, 1 + j]
-            d0, s = point_on_link(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
-            if d0 < 0.0 or d0 > lk[b, 2]:
+            d0, s = point_on_link(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b, LK_TX], lk[b, LK_TY])
+            if d0 < 0.0 or d0 > lk[b, LK_LENGTH]:
                 continue
             if s >= rho or s <= -rho:
                 continue
@@ -240,19 +241,19 @@ def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, m
             else:
                 rate = -_link_rate(wv[i, 0], wv[i, 1], avel, lk, b, d0) if damped else 0.0
                 p, e, pd = law_force(law, rho - s, rate, mem, row, b)
-            fx = p * lk[b, 1]
-            fy = -p * lk[b, 0]
+            fx = p * lk[b, LK_TY]
+            fy = -p * lk[b, LK_TX]
             fwx += fx
             fwy += fy
             energy += e
             dissipation += pd
             power += fx * wv[i, 0] + fy * wv[i, 1]
-            power += _link_load(fpin, avel, b, d0, lk[b, 2], -fx, -fy)
+            power += _link_load(fpin, avel, b, d0, lk[b, LK_LENGTH], -fx, -fy)
         row = r1 + i
         for j in range(nbr[row, NB_COUNT]):
             b = nbr[row, 1 + j]
-            weight = pin_cap_weight(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0],
-                                    lk[b, 1], True, continuous)
+            weight = pin_cap_weight(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, LK_TX], lk[b - 1, LK_TY], lk[b, LK_TX],
+                                    lk[b, LK_TY], True, continuous)
             if weight == 0:
                 continue
             dx = wc[i, 0] - apos[b, 0]
@@ -362,9 +363,9 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
         cy = corners[c, 1]
         for j in range(nbr[r_link + c, NB_COUNT]):
             b = nbr[r_link + c, 1 + j]
-            d0, s_in = point_on_link(cx, cy, apos[b, 0], apos[b, 1], lk[b, 0], lk[b, 1])
+            d0, s_in = point_on_link(cx, cy, apos[b, 0], apos[b, 1], lk[b, LK_TX], lk[b, LK_TY])
             s = -s_in  # along the outer normal -n_inner
-            if d0 < 0.0 or d0 > lk[b, 2] or s >= hg or s <= -hw:
+            if d0 < 0.0 or d0 > lk[b, LK_LENGTH] or s >= hg or s <= -hw:
                 continue
             if s < 0.0:
                 diag[D_STATUS] = CORNER_THROUGH_TRACK
@@ -374,18 +375,18 @@ def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
             else:
                 rate = _link_rate(0.0, 0.0, avel, lk, b, d0) if damped else 0.0   # -ds/dt: s = -s_in
                 p, e, pd = law_force(law, hg - s, rate, mem, r_link + c, b)
-            fx = p * lk[b, 1]
-            fy = -p * lk[b, 0]
+            fx = p * lk[b, LK_TY]
+            fy = -p * lk[b, LK_TX]
             gx += fx
             gy += fy
             corner_force += p
             energy += e
             dissipation += pd
-            power += _link_load(fpin, avel, b, d0, lk[b, 2], fx, fy)
+            power += _link_load(fpin, avel, b, d0, lk[b, LK_LENGTH], fx, fy)
             obstacle += p
         for j in range(nbr[r_pin + c, NB_COUNT]):
             b = nbr[r_pin + c, 1 + j]
-            weight = pin_cap_weight(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, 0], lk[b - 1, 1], lk[b, 0], lk[b, 1],
+            weight = pin_cap_weight(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, LK_TX], lk[b - 1, LK_TY], lk[b, LK_TX], lk[b, LK_TY],
                                     False, continuous)
             if weight == 0:
                 continue

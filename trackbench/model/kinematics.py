@@ -10,7 +10,7 @@ from numba import njit
 from .bundles import ARM_COLS, ARM_COS, ARM_SIN
 from .jit import INLINE, KERNEL
 from .index import q_pin
-from .layout import P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y
+from .layout import ARMS_PX, ARMS_PY, P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y
 
 
 @njit(**INLINE)
@@ -23,8 +23,18 @@ def body_offset(c, s, bx, by):
 def wheel_offset(c, s, arms, i, la, cb, sb):
     """Road-wheel centre of arm i relative to the chassis mass centre: pivot + l e_i,
     e_i = (cos beta_i, sin beta_i), beta_i = pitch + phi_i."""
-    px, py = body_offset(c, s, arms[i, 0], arms[i, 1])
+    px, py = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
     return px + la * cb, py + la * sb
+
+
+@njit(**INLINE)
+def _free_pins(coords, nw, out):
+    """The free pins' coordinates (or velocities: coords = q') into out[1:-1]; the track
+    ends are body points of the chassis."""
+    for b in range(1, out.shape[0] - 1):
+        k = q_pin(nw, b)
+        out[b, 0] = coords[k]
+        out[b, 1] = coords[k + 1]
 
 
 @njit(**INLINE)
@@ -50,10 +60,7 @@ def place(q, par, arms, ends, apos, wc, arm):
         rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
         apos[b, 0] = q[Q_X] + rx
         apos[b, 1] = q[Q_Y] + ry
-    for b in range(1, n_links):
-        k = q_pin(nw, b)
-        apos[b, 0] = q[k]
-        apos[b, 1] = q[k + 1]
+    _free_pins(q, nw, apos)
     return c, s
 
 
@@ -76,10 +83,7 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
         rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
         avel[b, 0] = qd[Q_X] - om * ry
         avel[b, 1] = qd[Q_Y] + om * rx
-    for b in range(1, n_links):
-        k = q_pin(nw, b)
-        avel[b, 0] = qd[k]
-        avel[b, 1] = qd[k + 1]
+    _free_pins(qd, nw, avel)
     return c, s
 
 

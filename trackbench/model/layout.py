@@ -98,6 +98,22 @@ SEG_NX = 5               # outward unit normal (out of the ground)
 SEG_NY = 6
 N_SEG_COLS = 7
 
+# --- link frames, ``lk`` (Work; one row per link, from gaps.link_frames) -------------
+LK_TX = 0                # unit direction t, pin b -> pin b+1
+LK_TY = 1
+LK_LENGTH = 2            # current length
+N_LK_COLS = 3
+
+# --- joints of the lee solver: constraint rows (Phi, lambda) and their vectors ``geo`` --
+J_X = 0                  # row 2 i + J_X: the x component of joint i
+J_Y = 1
+N_J_ROWS = 2             # constraint rows per joint (arm pivot)
+GEO_RX = 0               # r = R(theta) p_i, the pivot's body point turned with the chassis
+GEO_RY = 1
+GEO_LX = 2               # l (cos beta, sin beta), the arm from pivot to wheel centre
+GEO_LY = 3
+N_GEO_COLS = 4
+
 # --- contact pair kinds: the candidate lists hold one block of rows per kind --------
 K_WHEEL_LINK = 0         # row: wheel i; entries: links b          (Fig. 3, Eq. 4)
 K_WHEEL_PIN = 1          # row: wheel i; entries: free pins b      (Fig. 4)

@@ -18,6 +18,7 @@ from .kernels import track_loads
 from .kinematics import body_offset, positions
 from .index import nq_of, q_pin
 from .layout import (
+    ARMS_PX, ARMS_PY,
     ARMS_DAMPING, ARMS_PHI0, D_DISSIPATION, Y_DISSIPATED, Y_WORK, D_CHASSIS_AX, D_CHASSIS_AY, D_E_GRAVITY, D_E_KINETIC, D_E_TORSION, D_POWER, P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CHASSIS_INERTIA, P_CHASSIS_MASS, P_GRAVITY, P_PIN_MASS, P_TORSION_STIFFNESS, Q_ARM, Q_PITCH, Q_X, Q_Y,
 )
 
@@ -55,7 +56,7 @@ def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
     for i in range(arms.shape[0]):
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
-        px, py = body_offset(c, s, arms[i, 0], arms[i, 1])
+        px, py = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
         rx = px + la * cb
         ry = py + la * sb
         rpx = -ry           # d(w)/d(pitch)

@@ -2,9 +2,10 @@
 standard controller of Hairer, Norsett & Wanner (II.4), plus the retry that ends just
 after a contact switch located in a rejected step (events.py)."""
 
+import numpy as np
 from numba import njit
 
-from ..model.jit import BORROW, KERNEL
+from ..model.jit import BORROW, INLINE, KERNEL
 
 from ..model.layout import S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, S_STATUS, S_STEPS, S_T_FINAL
 from ..status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
@@ -12,6 +13,20 @@ from ..status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
 SAFETY = 0.9
 FAC_MIN = 0.2
 FAC_MAX = 10.0   # growth after an accepted step (1 right after a rejection)
+
+
+@njit(**INLINE)
+def loop_start():
+    """A time loop's counters at t = 0: (t, steps, rejected, smallest and largest accepted
+    step, growth limit, at_switch: the step being tried ends just after a located contact
+    switch)."""
+    return 0.0, 0, 0, np.inf, 0.0, FAC_MAX, False
+
+
+@njit(**INLINE)
+def counted(h, steps, h_lo, h_hi):
+    """(steps, h_lo, h_hi) after accepting a step of size h."""
+    return steps + 1, min(h_lo, h), max(h_hi, h)
 
 
 @njit(**BORROW)

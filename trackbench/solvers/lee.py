@@ -72,9 +72,9 @@ def run(scenario, model, y0):
     out_x, out_lam, lstats = lout
     W = ("time", "wheel")
     extra = {}
-    extra["joint_force_x"] = (W, out_lam[:n, 0::2], "N", "horizontal force of the chassis on arm i at its "
+    extra["joint_force_x"] = (W, out_lam[:n, L.J_X::L.N_J_ROWS], "N", "horizontal force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
-    extra["joint_force_y"] = (W, out_lam[:n, 1::2], "N", "vertical force of the chassis on arm i at its "
+    extra["joint_force_y"] = (W, out_lam[:n, L.J_Y::L.N_J_ROWS], "N", "vertical force of the chassis on arm i at its "
                                 "pivot (Lagrange multiplier lambda, acceleration level)")
     for dims, name, k, units, text in _FIGURES:
         extra[name] = (dims, out_x[:n, k] if dims else lstats[k], units, text)

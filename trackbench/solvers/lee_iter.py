@@ -38,6 +38,21 @@ def inf_norm(G):
 
 
 @njit(**BORROW)
+def _product_over(X, Y, q, tmp, out):
+    """out = X Y / q (out may be X or Y: the product goes through tmp)."""
+    m = X.shape[0]
+    for i in range(m):
+        for j in range(m):
+            acc = 0.0
+            for k in range(m):
+                acc += X[i, k] * Y[k, j]
+            tmp[i, j] = acc
+    for i in range(m):
+        for j in range(m):
+            out[i, j] = tmp[i, j] / q
+
+
+@njit(**BORROW)
 def accel_matrix(G, n, eps1, An, Cn, T, tmp):
     """Fill An (= A_n / w_n) for C_1 = G / ||G||_inf; returns (alpha_n, ||G||_inf)."""
     m = G.shape[0]
@@ -53,24 +68,8 @@ def accel_matrix(G, n, eps1, An, Cn, T, tmp):
         for i in range(m):
             for j in range(m):
                 T[i, j] = (b if i == j else 0.0) - Cn[i, j]
-        for i in range(m):         # A_n = T A_(n-1)
-            for j in range(m):
-                acc = 0.0
-                for k in range(m):
-                    acc += T[i, k] * An[k, j]
-                tmp[i, j] = acc
-        for i in range(m):
-            for j in range(m):
-                An[i, j] = tmp[i, j] / q
-        for i in range(m):         # C_n = C_(n-1) T
-            for j in range(m):
-                acc = 0.0
-                for k in range(m):
-                    acc += Cn[i, k] * T[k, j]
-                tmp[i, j] = acc
-        for i in range(m):
-            for j in range(m):
-                Cn[i, j] = tmp[i, j] / q
+        _product_over(T, An, q, tmp, An)    # A_n = T A_(n-1)
+        _product_over(Cn, T, q, tmp, Cn)    # C_n = C_(n-1) T
         eps = eps / q              # eps_n = eps_(n-1) w_(n-1), scaled by 1 / w_n
     return 2.0 / (1.0 + eps), gn
 

@@ -43,7 +43,7 @@ from ..model.index import z_arm, z_pin
 from ..model.layout import D_E_GRAVITY, D_STATUS, S_E0, Z_PITCH, ZA_BETA, Z_X
 from ..status import CONSTRAINT_ITERATION, NAN, SUCCESSFUL
 from .arrays import copy_2d, copy_into, set_row
-from .control import FAC_MAX, after_acceptance, after_rejection, before_step, finish_stats
+from .control import FAC_MAX, after_acceptance, after_rejection, before_step, counted, finish_stats, loop_start
 from .events import first_contact_switch
 from .hermite import hermite_second_order
 from .lee_iter import accel_matrix, acceleration_level, estimate_eps1, inf_norm, max_abs, update, velocity_level
@@ -346,16 +346,9 @@ def integrate_lee(y0, ctl, tab, ls, minv, m, w, ev, lw, out, lout):
     lstats = lout.lstats
     h = min(ctl.h0, ctl.h_max)
     status, e_ref, r_ref = _start(y0, h, ls, minv, m, w, lw, out, lout)
-    n_rhs = 1
-    n_out = 1
-    t = 0.0
     h_prev = 0.0
-    steps = 0
-    rejected = 0
-    h_lo = np.inf
-    h_hi = 0.0
-    fac_max = FAC_MAX
-    at_switch = False  # the step being tried ends just after a located contact switch
+    n_rhs = n_out = 1
+    t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
     while status == SUCCESSFUL and t < ctl.t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, ctl.t_end, steps, rejected, ctl.max_steps, ctl.h_min)
         if status != SUCCESSFUL:
@@ -380,9 +373,7 @@ def integrate_lee(y0, ctl, tab, ls, minv, m, w, ev, lw, out, lout):
             fac_max = 1.0
             continue
         t_new = t + h
-        steps += 1
-        h_lo = min(h_lo, h)
-        h_hi = max(h_hi, h)
+        steps, h_lo, h_hi = counted(h, steps, h_lo, h_hi)
         _maybe_rebuild(ls, minv, lw, lstats)
         it_v, err_v, it_a, err_a = _velocity_and_acceleration(h, tab, ls, minv, lw, lstats)   # 3, 4
         if it_v < 0 or it_a < 0:

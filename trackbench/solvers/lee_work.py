@@ -5,6 +5,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..model import layout as L
 from ..model.layout import n_absolute
 
 # Lee's iteration settings (scenario lee.*)
@@ -49,13 +50,13 @@ def lee_arrays(n_wheels, n_links, stages, n_diag, ny):
     return LeeWork(
         v(nz), v(nz), v(nz), v(nz), v(nz), v(nz),
         v(nz), np.zeros((stages, nz)), np.zeros((stages, nz)),
-        np.zeros((stages, n_pins, 2)), np.zeros((stages, n_wheels, 2)), np.zeros((stages, n_wheels, 4)),
+        np.zeros((stages, n_pins, 2)), np.zeros((stages, n_wheels, 2)), np.zeros((stages, n_wheels, L.N_GEO_COLS)),
         np.zeros((stages, n_diag)),
         v(nl), v(nl), v(nl), v(nl), v(nl), v(nl), v(nl), v(nl), v(nl),
         np.zeros((nl, nl)), np.zeros((nl, nl)), np.zeros((nl, nl)), np.zeros((nl, nl)), np.zeros((nl, nl)),
         v(2 * nz + 1), v(2 * nz + 1), v(2 * nz + 1), v(2 * nz + 1), v(2 * nz + 1),
         v(ny), v(ny), v(ny), v(ny), v(ny),
-        v(nz), np.zeros((n_pins, 2)), np.zeros((n_wheels, 4)), v(nz), v(nz),
+        v(nz), np.zeros((n_pins, 2)), np.zeros((n_wheels, L.N_GEO_COLS)), v(nz), v(nz),
         v(N_X), v(1 + n_wheels), v(N_SC))
 
 

@@ -19,7 +19,7 @@ from ..model.kernels import onset_in_step, remember_onsets
 from ..model.reduced import reduced_rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
-from .control import FAC_MAX, after_acceptance, after_rejection, before_step, finish_stats
+from .control import FAC_MAX, after_acceptance, after_rejection, before_step, counted, finish_stats, loop_start
 from .events import first_contact_switch
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
@@ -158,16 +158,9 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     nq = nq_of(ny)
     s = b.shape[0]
     status, e_ref, r_ref = _start(y0, m, w, lw, out)
-    n_rhs = 1
-    n_out = 1
-    t = 0.0
     h = min(ctl.h0, h_max)
-    steps = 0
-    rejected = 0
-    h_lo = np.inf
-    h_hi = 0.0
-    fac_max = FAC_MAX
-    at_switch = False  # the step being tried ends just after a located contact switch
+    n_rhs = n_out = 1
+    t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
@@ -195,9 +188,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
                 fac_max = 1.0
                 continue
         t_new = t + h
-        steps += 1
-        h_lo = min(h_lo, h)
-        h_hi = max(h_hi, h)
+        steps, h_lo, h_hi = counted(h, steps, h_lo, h_hi)
         status = _accepted_status(y_new, diag)
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
