@@ -207,83 +207,113 @@ def law_force(law, delta, rate, mem, row, partner):
     return normal_force(law, delta, rate, v0)
 
 
+# A probe is a point pressed against the track's pads: a road-wheel centre (reach r + h_w,
+# from the inner side) or a ground corner (reach h_g, from the outer side). rule = (side,
+# reach, wrong, status): side +1 for the inner side, -1 for the outer; a probe further than
+# `wrong` on the other side of a link's centre line is no contact, a nearer one went through
+# the track (status). probe = (x, y, vx, vy). acc = (fx, fy, normal force, energy, power,
+# obstacle force, dissipation): (fx, fy) the sum of the contact forces on the track, so the
+# probe takes minus it; carried through in the order of one loop.
+
+
 @njit(**INLINE)
-def wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, mem):
-    """Every road wheel against the track: links (Fig. 3, Eq. 4), then free pins in the
-    wedge (Fig. 4). mem: see law_force."""
-    law = contact_law(par, P_C_WHEEL)
+def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
+    """The probe against the candidate links of rows[0] where its foot lies on the link
+    (Fig. 3, Eq. 4; Fig. 5 right: along the link's normal, split to its pins by Eq. 7), then
+    against the round caps of the candidate free pins of rows[1], each as often as
+    gaps.pin_cap_weight counts it (the paper: the convex wedge, Figs. 4 and 6)."""
+    px, py, vx, vy = probe
+    side, reach, wrong, status = rule
+    row_link, row_pin = rows
+    apos, avel, lk, fpin = w.apos, w.avel, w.lk, w.fpin
+    ftx, fty, normal, energy, power, obstacle, dissipation = acc
     k = law[2]
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped    # the paper's spring: no call
+    for j in range(nbr[row_link, NB_COUNT]):
+        b = nbr[row_link, 1 + j]
+        d0, s_in = point_on_link(px, py, apos[b, 0], apos[b, 1], lk[b, LK_TX], lk[b, LK_TY])
+        s = side * s_in
+        if d0 < 0.0 or d0 > lk[b, LK_LENGTH] or s >= reach or s <= -wrong:
+            continue
+        if s < 0.0:
+            diag[D_STATUS] = status
+            continue
+        if plain:
+            p, e, pd = k * (reach - s), 0.5 * k * (reach - s) ** 2, 0.0  # Eqs. (4), (6)
+        else:
+            rate = -side * _link_rate(vx, vy, avel, lk, b, d0) if damped else 0.0
+            p, e, pd = law_force(law, reach - s, rate, mem, row_link, b)
+        fx = p * lk[b, LK_TY]     # p n_inner: a corner lifts the link
+        fy = -p * lk[b, LK_TX]
+        if side > 0.0:            # a wheel presses it down
+            fx = -fx
+            fy = -fy
+        ftx += fx
+        fty += fy
+        normal += p
+        energy += e
+        dissipation += pd
+        power -= fx * vx + fy * vy
+        power += _link_load(fpin, avel, b, d0, lk[b, LK_LENGTH], fx, fy)
+        obstacle += p
+    for j in range(nbr[row_pin, NB_COUNT]):
+        b = nbr[row_pin, 1 + j]
+        weight = pin_cap_weight(px, py, apos[b, 0], apos[b, 1], lk[b - 1, LK_TX], lk[b - 1, LK_TY], lk[b, LK_TX],
+                                lk[b, LK_TY], side > 0.0, continuous)
+        if weight == 0:
+            continue
+        dx = px - apos[b, 0]
+        dy = py - apos[b, 1]
+        dist = math.sqrt(dx * dx + dy * dy)
+        if dist >= reach:
+            continue
+        if plain:
+            p, e, pd = k * (reach - dist), 0.5 * k * (reach - dist) ** 2, 0.0
+        else:
+            rate = -(dx * (vx - avel[b, 0]) + dy * (vy - avel[b, 1])) / dist if damped else 0.0
+            p, e, pd = law_force(law, reach - dist, rate, mem, row_pin, b)
+        if weight != 1:
+            p, e, pd = weight * p, weight * e, weight * pd
+        fx = -p * dx / dist       # on the pin, away from the probe
+        fy = -p * dy / dist
+        fpin[b, 0] += fx
+        fpin[b, 1] += fy
+        ftx += fx
+        fty += fy
+        normal += p
+        energy += e
+        dissipation += pd
+        power += fx * (avel[b, 0] - vx) + fy * (avel[b, 1] - vy)
+        obstacle += p
+    return ftx, fty, normal, energy, power, obstacle, dissipation
+
+
+@njit(**INLINE)
+def wheel_contacts(w, m, diag, mem):
+    """Every road wheel against the track: links (Fig. 3, Eq. 4), then pin caps (Fig. 4).
+    mem: see law_force."""
+    par = m.par
+    law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
-    r0 = rows[K_WHEEL_LINK]
-    r1 = rows[K_WHEEL_PIN]
-    energy = 0.0
-    power = 0.0
-    dissipation = 0.0
-    for i in range(fwheel.shape[0]):
-        fwx = 0.0
-        fwy = 0.0
-        row = r0 + i
-        for j in range(nbr[row, NB_COUNT]):
-            b = nbr[row, 1 + j]
-            d0, s = point_on_link(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b, LK_TX], lk[b, LK_TY])
-            if d0 < 0.0 or d0 > lk[b, LK_LENGTH]:
-                continue
-            if s >= rho or s <= -rho:
-                continue
-            if s < 0.0:
-                diag[D_STATUS] = WHEEL_THROUGH_TRACK
-                continue
-            if plain:
-                p, e, pd = k * (rho - s), 0.5 * k * (rho - s) ** 2, 0.0  # Eq. (4)
-            else:
-                rate = -_link_rate(wv[i, 0], wv[i, 1], avel, lk, b, d0) if damped else 0.0
-                p, e, pd = law_force(law, rho - s, rate, mem, row, b)
-            fx = p * lk[b, LK_TY]
-            fy = -p * lk[b, LK_TX]
-            fwx += fx
-            fwy += fy
-            energy += e
-            dissipation += pd
-            power += fx * wv[i, 0] + fy * wv[i, 1]
-            power += _link_load(fpin, avel, b, d0, lk[b, LK_LENGTH], -fx, -fy)
-        row = r1 + i
-        for j in range(nbr[row, NB_COUNT]):
-            b = nbr[row, 1 + j]
-            weight = pin_cap_weight(wc[i, 0], wc[i, 1], apos[b, 0], apos[b, 1], lk[b - 1, LK_TX], lk[b - 1, LK_TY], lk[b, LK_TX],
-                                    lk[b, LK_TY], True, continuous)
-            if weight == 0:
-                continue
-            dx = wc[i, 0] - apos[b, 0]
-            dy = wc[i, 1] - apos[b, 1]
-            dist = math.sqrt(dx * dx + dy * dy)
-            if dist >= rho:
-                continue
-            if plain:
-                p, e, pd = k * (rho - dist), 0.5 * k * (rho - dist) ** 2, 0.0
-            else:
-                rate = -(dx * (wv[i, 0] - avel[b, 0]) + dy * (wv[i, 1] - avel[b, 1])) / dist if damped else 0.0
-                p, e, pd = law_force(law, rho - dist, rate, mem, row, b)
-            if weight != 1:
-                p, e, pd = weight * p, weight * e, weight * pd
-            fx = p * dx / dist
-            fy = p * dy / dist
-            fwx += fx
-            fwy += fy
-            fpin[b, 0] -= fx
-            fpin[b, 1] -= fy
-            energy += e
-            dissipation += pd
-            power += fx * (wv[i, 0] - avel[b, 0]) + fy * (wv[i, 1] - avel[b, 1])
-        fwheel[i, 0] = fwx
-        fwheel[i, 1] = fwy
+    rule = (1.0, rho, rho, WHEEL_THROUGH_TRACK)
+    acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    for i in range(w.fwheel.shape[0]):
+        probe = (w.wc[i, 0], w.wc[i, 1], w.wv[i, 0], w.wv[i, 1])
+        _, _, normal, energy, power, obstacle, dissipation = acc
+        acc = (0.0, 0.0, normal, energy, power, obstacle, dissipation)   # this wheel's force from 0
+        rows = (m.nbr_rows[K_WHEEL_LINK] + i, m.nbr_rows[K_WHEEL_PIN] + i)
+        acc = _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag, acc)
+        fwx = 0.0 - acc[0]
+        fwy = 0.0 - acc[1]
+        w.fwheel[i, 0] = fwx
+        w.fwheel[i, 1] = fwy
         diag[D_WHEEL + 2 * i] = fwx
         diag[D_WHEEL + 2 * i + 1] = fwy
-    diag[D_E_PAD_WHEEL] = energy
-    diag[D_POWER] += power
-    diag[D_DISSIPATION] += dissipation
+    diag[D_E_PAD_WHEEL] = acc[3]
+    diag[D_POWER] += acc[4]
+    diag[D_DISSIPATION] += acc[6]
 
 
 @njit(**INLINE)
@@ -345,83 +375,26 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
 
 
 @njit(**INLINE)
-def _corners(apos, avel, lk, fpin, par, corners, nbr, rows, diag, mem, acc):
-    """Every ground corner against the links (Fig. 5 right, split by Eq. 7) and against
-    free pins in the wedge (Fig. 6); acc as in _pins_on_ground."""
+def _corners(w, m, diag, mem, acc):
+    """Every convex ground corner against the links (Fig. 5 right, split by Eq. 7) and the
+    pin caps (Fig. 6); acc as in _pins_on_ground."""
+    par = m.par
     law = contact_law(par, P_C_GROUND)
-    k = law[2]
-    damped = law[1] != DAMPING_NONE
-    plain = law[0] == LAW_LINEAR and not damped
-    hg = par[P_PAD_GROUND]
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
-    r_link = rows[K_CORNER_LINK]
-    r_pin = rows[K_CORNER_PIN]
-    hw = par[P_PAD_WHEEL]
-    gx, gy, corner_force, energy, power, obstacle, dissipation = acc
-    for c in range(corners.shape[0]):
-        cx = corners[c, 0]
-        cy = corners[c, 1]
-        for j in range(nbr[r_link + c, NB_COUNT]):
-            b = nbr[r_link + c, 1 + j]
-            d0, s_in = point_on_link(cx, cy, apos[b, 0], apos[b, 1], lk[b, LK_TX], lk[b, LK_TY])
-            s = -s_in  # along the outer normal -n_inner
-            if d0 < 0.0 or d0 > lk[b, LK_LENGTH] or s >= hg or s <= -hw:
-                continue
-            if s < 0.0:
-                diag[D_STATUS] = CORNER_THROUGH_TRACK
-                continue
-            if plain:
-                p, e, pd = k * (hg - s), 0.5 * k * (hg - s) ** 2, 0.0
-            else:
-                rate = _link_rate(0.0, 0.0, avel, lk, b, d0) if damped else 0.0   # -ds/dt: s = -s_in
-                p, e, pd = law_force(law, hg - s, rate, mem, r_link + c, b)
-            fx = p * lk[b, LK_TY]
-            fy = -p * lk[b, LK_TX]
-            gx += fx
-            gy += fy
-            corner_force += p
-            energy += e
-            dissipation += pd
-            power += _link_load(fpin, avel, b, d0, lk[b, LK_LENGTH], fx, fy)
-            obstacle += p
-        for j in range(nbr[r_pin + c, NB_COUNT]):
-            b = nbr[r_pin + c, 1 + j]
-            weight = pin_cap_weight(cx, cy, apos[b, 0], apos[b, 1], lk[b - 1, LK_TX], lk[b - 1, LK_TY], lk[b, LK_TX], lk[b, LK_TY],
-                                    False, continuous)
-            if weight == 0:
-                continue
-            dx = cx - apos[b, 0]
-            dy = cy - apos[b, 1]
-            dist = math.sqrt(dx * dx + dy * dy)
-            if dist >= hg:
-                continue
-            if plain:
-                p, e, pd = k * (hg - dist), 0.5 * k * (hg - dist) ** 2, 0.0
-            else:
-                rate = (dx * avel[b, 0] + dy * avel[b, 1]) / dist if damped else 0.0
-                p, e, pd = law_force(law, hg - dist, rate, mem, r_pin + c, b)
-            if weight != 1:
-                p, e, pd = weight * p, weight * e, weight * pd
-            fx = -p * dx / dist
-            fy = -p * dy / dist
-            fpin[b, 0] += fx
-            fpin[b, 1] += fy
-            gx += fx
-            gy += fy
-            corner_force += p
-            energy += e
-            dissipation += pd
-            power += fx * avel[b, 0] + fy * avel[b, 1]
-            obstacle += p
-    return gx, gy, corner_force, energy, power, obstacle, dissipation
+    rule = (-1.0, par[P_PAD_GROUND], par[P_PAD_WHEEL], CORNER_THROUGH_TRACK)
+    for c in range(m.corners.shape[0]):
+        probe = (m.corners[c, 0], m.corners[c, 1], 0.0, 0.0)
+        rows = (m.nbr_rows[K_CORNER_LINK] + c, m.nbr_rows[K_CORNER_PIN] + c)
+        acc = _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag, acc)
+    return acc
 
 
 @njit(**INLINE)
-def ground_contacts(apos, avel, lk, fpin, par, seg, corners, nbr, rows, diag, mem):
+def ground_contacts(w, m, diag, mem):
     """The track against the ground: pins on segments, then the corners."""
-    acc = _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
-    gx, gy, corner_force, energy, power, obstacle, dissipation = _corners(apos, avel, lk, fpin, par, corners, nbr,
-                                                                          rows, diag, mem, acc)
+    acc = _pins_on_ground(w.apos, w.avel, w.fpin, m.par, m.seg, m.nbr, m.nbr_rows, mem,
+                          (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    gx, gy, corner_force, energy, power, obstacle, dissipation = _corners(w, m, diag, mem, acc)
     diag[D_E_PAD_GROUND] = energy
     diag[D_GROUND_FX] = gx
     diag[D_GROUND_FY] = gy
@@ -437,17 +410,16 @@ def track_loads(w, m, diag):
     overwritten, tension first): tension and contact forces on the pins (w.fpin, pins 0
     and n_links included), contact forces on the wheels (w.fwheel), energies, power and
     status in diag. Gravity is left to the caller."""
-    apos, avel, fpin, wc, wv, fwheel, lk = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.lk
-    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
+    apos, wc, par = w.apos, w.wc, m.par
     mem = (m.v0, w.pair_seen, w.pair_rate, m.counters, par[P_MIN_APPROACH])
     diag[D_STATUS] = 0.0
     diag[D_POWER] = 0.0
     diag[D_DISSIPATION] = 0.0
     m.counters[C_EVALUATIONS] += 1
-    refresh_neighbours(apos, wc, par, seg, corners, nbr, rows, m.ref, m.counters)
-    link_tensions(apos, avel, par, lk, fpin, diag, diag_tension(wc.shape[0]))
-    wheel_contacts(apos, avel, lk, wc, wv, fpin, fwheel, par, nbr, rows, diag, mem)
-    ground_contacts(apos, avel, lk, fpin, par, seg, corners, nbr, rows, diag, mem)
+    refresh_neighbours(apos, wc, par, m.seg, m.corners, m.nbr, m.nbr_rows, m.ref, m.counters)
+    link_tensions(apos, w.avel, par, w.lk, w.fpin, diag, diag_tension(wc.shape[0]))
+    wheel_contacts(w, m, diag, mem)
+    ground_contacts(w, m, diag, mem)
 
 
 @njit(**BORROW)
