@@ -2,6 +2,8 @@
 
 import math
 
+import numpy as np
+
 import pytest
 
 import trackbench as tb
@@ -51,3 +53,32 @@ def test_power_law_vehicle_starts_from_equilibrium(k):
     # softer pads than the paper's at these loads (compressions of 0.5-5 mm instead of 0.4 mm)
     linear = equilibrium(tb.Scenario.paper())
     assert eq.q[1] < linear.q[1]   # the chassis sits lower
+
+
+@pytest.fixture(scope="module")
+def sliding():
+    """The paper's vehicle on flat ground with ground friction mu = 0.3: its track is bolted to
+    the chassis, so the whole bottom run slides over the ground at the vehicle's speed."""
+    return tb.simulate(tb.Scenario.paper(**{"terrain": {"kind": "flat"}, "contact.friction": 0.3,
+                                            "duration": 0.3}))
+
+
+def test_sliding_track_feels_coulomb_friction(sliding):
+    ds = sliding
+    assert ds.attrs["status"] == "completed"
+    late = ds.time.values > 0.01
+    fx, fy = ds.ground_force_x.values[late], ds.ground_force_y.values[late]
+    # every pin slides at ~10 m/s >> friction_velocity: friction is mu times the normal force
+    np.testing.assert_allclose(fx / fy, -0.3, rtol=1e-4)
+    assert float(ds.chassis_vx[-1]) < float(ds.chassis_vx[0]) - 0.3 * 9.81 * 0.3 * 0.7
+    # the work-based residual closes with friction's work; friction dissipates
+    assert float(ds.max_energy_residual) < 1e-6
+    assert float(ds.energy_dissipated[-1]) > 1e5
+
+
+def test_regularised_friction_law():
+    from trackbench.model.contact_force import friction
+    assert friction(0.5, 0.01, 1000.0, 10.0) == pytest.approx(-500.0, rel=1e-6)
+    assert friction(0.5, 0.01, 1000.0, -10.0) == pytest.approx(500.0, rel=1e-6)
+    assert friction(0.5, 0.01, 1000.0, 0.0) == 0.0
+    assert abs(friction(0.5, 0.01, 1000.0, 0.001)) < 0.1 * 500.0   # below v_eps: a viscous law

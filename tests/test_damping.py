@@ -80,6 +80,9 @@ def test_restitution_laws_on_the_vehicle(law):
     ({"preset": "damped", "solver": "lee"}, "solver = 'lee'"),
     ({"contact.geometry": "smooth"}, "contact.geometry"),
     ({"contact.geometry": "continuous", "solver": "lee"}, "contact.geometry"),
+    ({"contact.friction": -0.1}, "contact.friction"),
+    ({"contact.friction_velocity": 0.0}, "contact.friction_velocity"),
+    ({"contact.friction": 0.5, "solver": "lee"}, "contact.friction"),
 ])
 def test_bad_damping_input_is_one_line(bad, words):
     with pytest.raises(ScenarioError) as e:

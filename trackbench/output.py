@@ -75,7 +75,8 @@ def _energies(result, nq):
                                      "energy balance deviation relative to the initial total energy"),
         "contact_work": _var(T, work, "J", "work done by all contact forces and dampers since t = 0"),
         "energy_dissipated": _var(T, dissipated, "J", "energy dissipated by all dampers since t = 0 (contact "
-                                  "damping, link dashpots, shock absorbers); 0 in the paper's model"),
+                                  "damping, link dashpots, shock absorbers) and ground friction; 0 in "
+                                  "the paper's model"),
         "energy_residual": _var(T, (residual - residual[0]) / e0, "1",
                                 "work-based residual: kinetic + torsion + tension + gravity - work of the "
                                 "contact forces and dampers, change since t = 0 relative to the initial total "

@@ -102,6 +102,8 @@ RULES = {
     "contact.damping_ramp": (float, 0.0, 0.1, "a number in (0, 0.1] m"),
     "contact.min_approach_speed": (float, 0.0, 100.0, "a number in (0, 100] m/s"),
     "contact.geometry": (str, tuple(GEOMETRIES), None, "one of " + ", ".join(GEOMETRIES)),
+    "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
+    "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
     "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
@@ -111,7 +113,8 @@ RULES = {
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }
 _OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent",
-             "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed"} | {
+             "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed",
+             "contact.friction_velocity"} | {
     k for k, r in RULES.items() if r is _POS}
 
 TERRAIN_RULES = {
@@ -418,7 +421,8 @@ def _check_extensions(d, explicit):
     if d["solver"] == "lee":
         ext = [name for name, on in (
             ("contact.law", c["law"] != "linear"), ("contact.damping", c["damping"] != "none"),
-            ("contact.geometry", c["geometry"] != "paper"), ("track.link_damping", d["track"]["link_damping"] > 0),
+            ("contact.geometry", c["geometry"] != "paper"), ("contact.friction", c["friction"] > 0),
+            ("track.link_damping", d["track"]["link_damping"] > 0),
             ("vehicle.arm_damping", any(a > 0 for a in arms))) if on]
         if ext:
             raise ScenarioError(f"solver = 'lee' runs the paper's model only, but {ext[0]} is set; "

@@ -1,6 +1,8 @@
 """The normal-force law of every penalty contact, compiled (contact_laws.py has the
 formulas, their sources and the codes)."""
 
+import math
+
 from numba import njit
 
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, LAW_POWER
@@ -14,6 +16,14 @@ def elastic(law, k, n, delta):
         f = k * delta ** n
         return f, f * delta / (n + 1.0)
     return k * delta, 0.5 * k * delta ** 2
+
+
+@njit(**SCALAR)
+def friction(mu, v_eps, p, v_t):
+    """Regularised Coulomb friction of a contact pressed with normal force p, sliding at
+    v_t: the force along the sliding direction, -mu p v_t / sqrt(v_t^2 + v_eps^2) (it
+    reaches mu p well above v_eps; a body held on a slope creeps at a speed of order v_eps)."""
+    return -mu * p * v_t / math.sqrt(v_t * v_t + v_eps * v_eps)
 
 
 @njit(**SCALAR)

@@ -16,13 +16,13 @@ from numba import njit
 from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 from .gaps import (ground_distance, link_frames, pin_cap_weight, pin_ground_selection, pin_segment_valid, point_on_link,
                    point_on_segment, segment_coords)
-from .contact_force import normal_force
+from .contact_force import friction, normal_force
 from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
     LK_LENGTH, LK_TX, LK_TY,
-    C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
+    C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_FRICTION, P_FRICTION_VELOCITY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 
 
@@ -207,6 +207,25 @@ def law_force(law, delta, rate, mem, row, partner):
     return normal_force(law, delta, rate, v0)
 
 
+@njit(**INLINE)
+def _slip(mu, v_eps, p, vx, vy, tx, ty):
+    """Friction on a track point sliding at (vx, vy) relative to what it presses on, along
+    the contact's unit tangent t, under normal force p: (fx, fy, dissipated power)."""
+    vt = vx * tx + vy * ty
+    ft = friction(mu, v_eps, p, vt)
+    return ft * tx, ft * ty, -ft * vt
+
+
+@njit(**INLINE)
+def _link_friction(avel, lk, b, d0, vx, vy, p, mu, v_eps):
+    """_slip of link b's point at d0 from pin b (its velocity the Eq. 7 blend of the pins')
+    past a probe moving at (vx, vy), along the link."""
+    w1 = d0 / lk[b, LK_LENGTH]
+    ux = (1.0 - w1) * avel[b, 0] + w1 * avel[b + 1, 0] - vx
+    uy = (1.0 - w1) * avel[b, 1] + w1 * avel[b + 1, 1] - vy
+    return _slip(mu, v_eps, p, ux, uy, lk[b, LK_TX], lk[b, LK_TY])
+
+
 # A probe is a point pressed against the track's pads: a road-wheel centre (reach r + h_w,
 # from the inner side) or a ground corner (reach h_g, from the outer side). rule = (side,
 # reach, wrong, status): side +1 for the inner side, -1 for the outer; a probe further than
@@ -223,7 +242,7 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
     against the round caps of the candidate free pins of rows[1], each as often as
     gaps.pin_cap_weight counts it (the paper: the convex wedge, Figs. 4 and 6)."""
     px, py, vx, vy = probe
-    side, reach, wrong, status = rule
+    side, reach, wrong, status, mu, v_eps = rule
     row_link, row_pin = rows
     apos, avel, lk, fpin = w.apos, w.avel, w.lk, w.fpin
     ftx, fty, normal, energy, power, obstacle, dissipation = acc
@@ -249,6 +268,11 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
         if side > 0.0:            # a wheel presses it down
             fx = -fx
             fy = -fy
+        if mu > 0.0:
+            gx, gy, fd = _link_friction(avel, lk, b, d0, vx, vy, p, mu, v_eps)
+            fx += gx
+            fy += gy
+            dissipation += fd
         ftx += fx
         fty += fy
         normal += p
@@ -277,6 +301,11 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
             p, e, pd = weight * p, weight * e, weight * pd
         fx = -p * dx / dist       # on the pin, away from the probe
         fy = -p * dy / dist
+        if mu > 0.0:              # friction across that line
+            gx, gy, fd = _slip(mu, v_eps, p, avel[b, 0] - vx, avel[b, 1] - vy, dy / dist, -dx / dist)
+            fx += gx
+            fy += gy
+            dissipation += fd
         fpin[b, 0] += fx
         fpin[b, 1] += fy
         ftx += fx
@@ -297,7 +326,7 @@ def wheel_contacts(w, m, diag, mem):
     law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
-    rule = (1.0, rho, rho, WHEEL_THROUGH_TRACK)
+    rule = (1.0, rho, rho, WHEEL_THROUGH_TRACK, 0.0, 1.0)   # frictionless
     acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for i in range(w.fwheel.shape[0]):
         probe = (w.wc[i, 0], w.wc[i, 1], w.wv[i, 0], w.wv[i, 1])
@@ -329,6 +358,8 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
+    mu = par[P_FRICTION]
+    v_eps = par[P_FRICTION_VELOCITY]
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
@@ -362,6 +393,11 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
                 p, e, pd = law_force(law, hg - s, rate, mem, row, partner)
             fx = p * nx
             fy = p * ny
+            if mu > 0.0:   # friction along the surface
+                gx_f, gy_f, pd_f = _slip(mu, v_eps, p, avel[b, 0], avel[b, 1], ny, -nx)
+                fx += gx_f
+                fy += gy_f
+                dissipation += pd_f
             fpin[b, 0] += fx
             fpin[b, 1] += fy
             gx += fx
@@ -381,7 +417,8 @@ def _corners(w, m, diag, mem, acc):
     par = m.par
     law = contact_law(par, P_C_GROUND)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
-    rule = (-1.0, par[P_PAD_GROUND], par[P_PAD_WHEEL], CORNER_THROUGH_TRACK)
+    rule = (-1.0, par[P_PAD_GROUND], par[P_PAD_WHEEL], CORNER_THROUGH_TRACK, par[P_FRICTION],
+            par[P_FRICTION_VELOCITY])
     for c in range(m.corners.shape[0]):
         probe = (m.corners[c, 0], m.corners[c, 1], 0.0, 0.0)
         rows = (m.nbr_rows[K_CORNER_LINK] + c, m.nbr_rows[K_CORNER_PIN] + c)

@@ -176,7 +176,9 @@ P_DAMPING_RAMP = 22      # d_r (m)
 P_MIN_APPROACH = 23      # approach speed below which v0 counts as this (m/s)
 P_LINK_DAMPING = 24      # axial dashpot of every link (N s/m)
 P_CONTACT_GEOMETRY = 25   # GEOMETRY_* code (contact_laws.py)
-N_PAR = 26
+P_FRICTION = 26          # Coulomb coefficient mu between ground and track
+P_FRICTION_VELOCITY = 27  # regularising speed of the friction law (m/s)
+N_PAR = 28
 
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point

@@ -60,6 +60,8 @@ def paper_contact():
         "damping_ramp": 2e-4,             # d_r: depth over which the viscous dashpot ramps in (m)
         "min_approach_speed": 0.1,        # approach speeds below this count as this (m/s)
         "geometry": "paper",              # or "continuous"
+        "friction": 0.0,                  # Coulomb mu between ground and track (0: the paper)
+        "friction_velocity": 0.01,        # regularising speed of the friction law (m/s)
     }
 
 
@@ -99,6 +101,8 @@ def _pack_contact(par, contact):
     par[L.P_DAMPING_RAMP] = contact["damping_ramp"]
     par[L.P_MIN_APPROACH] = contact["min_approach_speed"]
     par[L.P_CONTACT_GEOMETRY] = GEOMETRIES[contact["geometry"]]
+    par[L.P_FRICTION] = contact["friction"]
+    par[L.P_FRICTION_VELOCITY] = contact["friction_velocity"]
 
 
 def pack(vehicle, track, gravity, contact=None):
