@@ -208,22 +208,43 @@ def law_force(law, delta, rate, mem, row, partner):
 
 
 @njit(**INLINE)
-def _slip(mu, v_eps, p, vx, vy, tx, ty):
-    """Friction on a track point sliding at (vx, vy) relative to what it presses on, along
-    the contact's unit tangent t, under normal force p: (fx, fy, dissipated power)."""
-    vt = vx * tx + vy * ty
+def _slip(mu, v_eps, p, v, t, fx, fy):
+    """The force (fx, fy) on a track point plus its friction, the point sliding at v relative
+    to what it presses on, along the contact's unit tangent t, under normal force p; and
+    friction's dissipated power."""
+    vt = v[0] * t[0] + v[1] * t[1]
     ft = friction(mu, v_eps, p, vt)
-    return ft * tx, ft * ty, -ft * vt
+    return fx + ft * t[0], fy + ft * t[1], -ft * vt
 
 
 @njit(**INLINE)
-def _link_friction(avel, lk, b, d0, vx, vy, p, mu, v_eps):
+def _link_friction(avel, lk, b, d0, probe_force, p, mu, v_eps):
     """_slip of link b's point at d0 from pin b (its velocity the Eq. 7 blend of the pins')
-    past a probe moving at (vx, vy), along the link."""
+    past a probe, along the link; probe_force = (probe vx, vy, force fx, fy on the link)."""
+    vx, vy, fx, fy = probe_force
     w1 = d0 / lk[b, LK_LENGTH]
     ux = (1.0 - w1) * avel[b, 0] + w1 * avel[b + 1, 0] - vx
     uy = (1.0 - w1) * avel[b, 1] + w1 * avel[b + 1, 1] - vy
-    return _slip(mu, v_eps, p, ux, uy, lk[b, LK_TX], lk[b, LK_TY])
+    return _slip(mu, v_eps, p, (ux, uy), (lk[b, LK_TX], lk[b, LK_TY]), fx, fy)
+
+
+@njit(**INLINE)
+def _push_pin(fpin, avel, b, force, other_v, tangent, fr, acc, counts):
+    """A contact force on pin b into fpin and acc (layout of _probe_on_track's): force =
+    (fx, fy, normal force p, pad energy, damping power), other_v the velocity of what the
+    pin presses on, friction fr = (mu, v_eps) along the unit tangent, counts = what the
+    force adds to acc's normal and obstacle sums."""
+    fx, fy, p, e, pd = force
+    vx, vy = other_v
+    mu, v_eps = fr
+    ftx, fty, normal, energy, power, obstacle, dissipation = acc
+    if mu > 0.0:
+        fx, fy, fd = _slip(mu, v_eps, p, (avel[b, 0] - vx, avel[b, 1] - vy), tangent, fx, fy)
+        dissipation += fd
+    fpin[b, 0] += fx
+    fpin[b, 1] += fy
+    power += fx * (avel[b, 0] - vx) + fy * (avel[b, 1] - vy)
+    return ftx + fx, fty + fy, normal + counts[0], energy + e, power, obstacle + counts[1], dissipation + pd
 
 
 # A probe is a point pressed against the track's pads: a road-wheel centre (reach r + h_w,
@@ -269,9 +290,7 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
             fx = -fx
             fy = -fy
         if mu > 0.0:
-            gx, gy, fd = _link_friction(avel, lk, b, d0, vx, vy, p, mu, v_eps)
-            fx += gx
-            fy += gy
+            fx, fy, fd = _link_friction(avel, lk, b, d0, (vx, vy, fx, fy), p, mu, v_eps)
             dissipation += fd
         ftx += fx
         fty += fy
@@ -299,22 +318,10 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
             p, e, pd = law_force(law, reach - dist, rate, mem, row_pin, b)
         if weight != 1:
             p, e, pd = weight * p, weight * e, weight * pd
-        fx = -p * dx / dist       # on the pin, away from the probe
-        fy = -p * dy / dist
-        if mu > 0.0:              # friction across that line
-            gx, gy, fd = _slip(mu, v_eps, p, avel[b, 0] - vx, avel[b, 1] - vy, dy / dist, -dx / dist)
-            fx += gx
-            fy += gy
-            dissipation += fd
-        fpin[b, 0] += fx
-        fpin[b, 1] += fy
-        ftx += fx
-        fty += fy
-        normal += p
-        energy += e
-        dissipation += pd
-        power += fx * (avel[b, 0] - vx) + fy * (avel[b, 1] - vy)
-        obstacle += p
+        acc = (ftx, fty, normal, energy, power, obstacle, dissipation)
+        force = (-p * dx / dist, -p * dy / dist, p, e, pd)    # on the pin, away from the probe
+        acc = _push_pin(fpin, avel, b, force, (vx, vy), (dy / dist, -dx / dist), (mu, v_eps), acc, (p, p))
+        ftx, fty, normal, energy, power, obstacle, dissipation = acc
     return ftx, fty, normal, energy, power, obstacle, dissipation
 
 
@@ -391,22 +398,10 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
             else:
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = law_force(law, hg - s, rate, mem, row, partner)
-            fx = p * nx
-            fy = p * ny
-            if mu > 0.0:   # friction along the surface
-                gx_f, gy_f, pd_f = _slip(mu, v_eps, p, avel[b, 0], avel[b, 1], ny, -nx)
-                fx += gx_f
-                fy += gy_f
-                dissipation += pd_f
-            fpin[b, 0] += fx
-            fpin[b, 1] += fy
-            gx += fx
-            gy += fy
-            energy += e
-            dissipation += pd
-            power += fx * avel[b, 0] + fy * avel[b, 1]
-            if sj > 0:
-                obstacle += p
+            acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
+            acc = _push_pin(fpin, avel, b, (p * nx, p * ny, p, e, pd), (0.0, 0.0), (ny, -nx), (mu, v_eps), acc,
+                            (0.0, p if sj > 0 else 0.0))
+            gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     return gx, gy, corner_force, energy, power, obstacle, dissipation
 
 
