@@ -343,11 +343,11 @@ def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tm
     real = store.write_timeseries
     victim = load_study(p, output=out).runs[1].run_id
 
-    def write(ds, path, compress=False):
+    def write(ds, path, storage="full"):
         if Path(path).parent.name == victim:
             Path(path).with_name(".timeseries.nc.x.tmp").write_bytes(b"half")  # cleaned by the coordinator
             raise OSError(errno.ENOSPC, "No space left on device")
-        return real(ds, path, compress)
+        return real(ds, path, storage)
     monkeypatch.setattr(executors, "run_local", _serial)
     monkeypatch.setattr(store, "write_timeseries", write)
     o = run_study(p, output=out, quiet=True)
@@ -370,7 +370,7 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
     run = s.runs[0]
     task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}}
 
-    def hdf(ds, path, compress=False):
+    def hdf(ds, path, storage="full"):
         raise RuntimeError("NetCDF: HDF error")
     monkeypatch.setattr(store, "write_timeseries", hdf)
     rec = executors.execute_run(task)          # plenty of space: the error as it is

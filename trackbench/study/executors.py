@@ -28,19 +28,21 @@ def run_summary(ds):
     return Q.without_nan(Q.values(ds))
 
 
-def _record(ds, rdir, scenario):
-    """Write recording.rrd beside timeseries.nc when asked and possible; returns (name, error)."""
+def _record(ds, rdir, scenario, storage="full"):
+    """Write recording.rrd beside timeseries.nc when asked and possible (thinned for compact
+    storage); returns (name, error)."""
     if not scenario.get("record", {}).get("enabled"):
         return None, None
     try:
-        from ..replay.record import write_recording
+        from ..replay.record import thinning, write_recording
     except ImportError as e:
         return None, f"recording skipped: trackbench.replay.record is not available ({e})"
     try:
         target = Path(rdir) / "recording.rrd"
         tmp = store.tmp_path(target) + ".rrd"
         try:   # a writer of its own temporary: whatever happens inside, only a finished file lands
-            write_recording(ds, tmp, every=int(scenario["record"].get("every", 1)))
+            frames, signals = thinning(scenario["record"].get("every", 1), storage)
+            write_recording(ds, tmp, every=frames, signal_every=signals)
             os.replace(tmp, target)
         finally:
             for p in (tmp, tmp[:-4]):
@@ -55,7 +57,8 @@ def execute_run(task):
     """Run one study run in this process and write its folder; returns the run.json dict.
 
     task: run_id, output (absolute: the study folder as every worker sees it), scenario
-    (resolved dict), meta (study, variant, replicate, params), compress, attempt, attempt_id.
+    (resolved dict), meta (study, variant, replicate, params), storage ("full" or "compact"),
+    attempt, attempt_id.
     Never raises for a failing run: the failure is the record (its reason in status_message,
     the original exception in exception)."""
     t0 = time.perf_counter()
@@ -154,8 +157,9 @@ def _simulate(task, rec):
 
 def _write(ds, rdir, task, rec):
     """timeseries.nc (and the recording) of a finished simulation; the solver's verdict in ``rec``."""
+    storage = task.get("storage", "full")
     try:
-        store.write_timeseries(ds, rdir / "timeseries.nc", compress=task.get("compress", False))
+        store.write_timeseries(ds, rdir / "timeseries.nc", storage)
     except Exception as e:
         _fail(rec, e, rdir, need_bytes=ds.nbytes)
         return
@@ -163,8 +167,8 @@ def _write(ds, rdir, task, rec):
     msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-               timeseries="timeseries.nc", results=run_summary(ds))
-    rec["recording"], err = _record(ds, rdir, task["scenario"])
+               timeseries="timeseries.nc", storage=storage, results=run_summary(ds))
+    rec["recording"], err = _record(ds, rdir, task["scenario"], storage)
     if err:
         rec["recording_error"] = err
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import executors, store
+from ..storage import check_storage
 from .spec import load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
@@ -58,19 +59,20 @@ def manifest(study):
     """runs.json: the study's runs as expanded now, so the folder can be read later even when
     the package's defaults (and so a re-expansion's run ids) have changed."""
     return {"name": study.name, "description": study.description, "replicates": study.replicates,
-            "param_names": study.param_names,
+            "storage": study.storage, "param_names": study.param_names,
             "runs": [{"run_id": r.run_id, "index": r.index, "variant": r.variant, "replicate": r.replicate,
                       "params": r.params, "scenario": r.scenario} for r in study.runs]}
 
 
 def plan(study, force=False):
-    """(tasks to run, ids already completed)."""
+    """(tasks to run, ids already completed); each task stores its files as study.storage says."""
     tasks, done = [], []
     for run in study.runs:
         if not force and store.is_completed(study.output, run.run_id):
             done.append(run.run_id)
             continue
         tasks.append({"run_id": run.run_id, "output": str(study.output), "scenario": run.scenario,
+                      "storage": study.storage,
                       "meta": {"study": study.name, "index": run.index, "variant": run.variant,
                                "replicate": run.replicate, "params": run.params}})
     return tasks, done
@@ -123,13 +125,17 @@ class _Progress:
 
 
 def run_study(path, workers=2, executor="local", scheduler=None, force=False, output=None,
-              quiet=False, compress=False):
+              quiet=False, storage=None):
     """Run a study file; raises StudyError / ValueError before anything starts on bad input,
-    StudyLocked when another process works on the same folder."""
+    StudyLocked when another process works on the same folder. ``storage`` ("full" or
+    "compact") overrides the study file's [study] storage."""
     if not isinstance(workers, int) or workers < 1:
         raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
     executors.check_executor(executor, scheduler)
+    if storage is not None:
+        check_storage(storage)
     study = load_study(path, output=output)
+    study.storage = storage or study.storage
     # workers get absolute paths only: a relative one would land in each worker's own cwd
     study.output = Path(os.path.abspath(study.output))
     out = Outcome(study=study)
@@ -139,8 +145,6 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
-        for t in tasks:
-            t["compress"] = compress
         out.skipped = len(done)
         progress = _Progress(len(tasks), len(done), quiet)
         if executor == "dask":
