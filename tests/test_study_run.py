@@ -245,7 +245,7 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     from trackbench.study.executors import execute_run
     mod = types.ModuleType("trackbench.replay.record")
 
-    def boom(ds, path, every=1):
+    def boom(ds, path, every=1, signal_every=1):
         Path(path).write_text("partial")
         raise RuntimeError("disk full")
     mod.write_recording = boom
@@ -258,7 +258,7 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     assert rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]
     assert sorted(os.listdir(store.run_dir(s.output, run.run_id))) == ["run.json", "timeseries.nc"]
 
-    def ok(ds, path, every=1):
+    def ok(ds, path, every=1, signal_every=1):
         Path(path).write_text(f"rrd every={every}")
     mod.write_recording = ok
     rec = execute_run(task)

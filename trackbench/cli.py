@@ -67,11 +67,11 @@ def study_run(
                                                      "else full. Runs already completed keep their files."),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
+    study = _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:
-        outcome = run_study(file, workers=workers, executor=executor, scheduler=scheduler, force=force,
+        outcome = run_study(study, workers=workers, executor=executor, scheduler=scheduler, force=force,
                             storage=storage)
     except (StudyError, ValueError) as e:
         _fail(str(e))

@@ -16,6 +16,7 @@ The netCDF file is written with netCDF4 directly (xarray's to_netcdf spent about
 the write on encoding checks); xarray reads it as it read the files before.
 """
 
+
 import numpy as np
 
 STORAGES = ("full", "compact")
@@ -38,6 +39,14 @@ def check_storage(value, where="--storage"):
     if value not in STORAGES:
         raise ValueError(f"{where} {value!r} is not allowed: expected {' or '.join(STORAGES)}")
     return value
+
+
+def recording_steps(every, storage="full"):
+    """(side-view frame step, time-series step) of a recording: compact storage thins both,
+    full keeps the scenario's record.every and every sample of the time series."""
+    if storage == "compact":
+        return max(int(every), COMPACT_FRAME_EVERY), COMPACT_SIGNAL_EVERY
+    return int(every), 1
 
 
 def is_history(name, var):
@@ -82,10 +91,13 @@ def layout(name, var, storage):
 
 
 def write(ds, path, storage="full"):
-    """Write ``ds`` to the netCDF-4 file ``path`` (not atomically: output.write_netcdf is)."""
+    """Write ``ds`` to the netCDF-4 file ``path`` (not atomically: output.write_netcdf is,
+    and it empties a temporary file that failed: netCDF keeps a file open whose closing
+    failed, e.g. on a full disk, and its space would stay taken)."""
     import netCDF4
     codec = COMPACT_CODEC if storage == "compact" else FULL_CODEC
-    with netCDF4.Dataset(path, "w", format="NETCDF4") as f:
+    f = netCDF4.Dataset(path, "w", format="NETCDF4")
+    try:
         for dim, n in ds.sizes.items():
             f.createDimension(dim, n)
         for name, var in ds.variables.items():
@@ -97,4 +109,6 @@ def write(ds, path, storage="full"):
             v.setncatts({**var.attrs, **extra})
             v[...] = data
         f.setncatts({**ds.attrs, "storage": storage})
+    finally:
+        f.close()
     return path

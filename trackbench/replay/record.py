@@ -391,20 +391,12 @@ def write_recording(ds, path, every=1, signal_every=1):
     return path
 
 
-def thinning(every, storage="full"):
-    """(side-view frame step, time-series step) of a recording for ``storage``: compact storage
-    thins both (trackbench/storage.py), full keeps the scenario's record.every and every sample."""
-    from ..storage import COMPACT_FRAME_EVERY, COMPACT_SIGNAL_EVERY
-    if storage == "compact":
-        return max(int(every), COMPACT_FRAME_EVERY), COMPACT_SIGNAL_EVERY
-    return int(every), 1
-
-
 def maybe_write_recording(ds, folder, name=RECORDING_NAME, storage="full"):
     """Write folder/name when the scenario's record.enabled is true (with its record.every,
     thinned for compact storage); returns the Path, or None when recording is switched off."""
     enabled, every = record_settings(ds)
     if not enabled:
         return None
-    frames, signals = thinning(every, storage)
+    from ..storage import recording_steps
+    frames, signals = recording_steps(every, storage)
     return write_recording(ds, Path(folder) / name, every=frames, signal_every=signals)

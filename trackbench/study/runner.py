@@ -12,7 +12,7 @@ from pathlib import Path
 
 from . import executors, store
 from ..storage import check_storage
-from .spec import load_study, resolved_toml
+from .spec import Study, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
 
@@ -79,12 +79,13 @@ def plan(study, force=False):
 
 
 class _Progress:
-    """A rich progress bar on a terminal; one plain line per finished run otherwise."""
+    """A live rich progress bar on a terminal (done, failed, running, elapsed, ETA); one plain
+    line per finished run otherwise (a log, a pipe, CI)."""
 
-    def __init__(self, total, skipped, quiet=False, stream=None):
+    def __init__(self, total, skipped, quiet=False, stream=None, workers=1):
         from rich.console import Console
         self.console = Console(file=stream or sys.stderr)
-        self.total, self.done, self.failed = total, 0, 0
+        self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
         self.quiet, self.t0 = quiet, time.perf_counter()
         self.bar = None
         if not quiet and self.console.is_terminal and total:
@@ -97,8 +98,18 @@ class _Progress:
         elif not quiet:
             self.console.print(f"{total} runs to do, {skipped} already completed", highlight=False)
 
+    def _running(self):
+        left = self.total - self.done - self.failed
+        return min(left, self.workers if self.in_flight is None else self.in_flight)
+
     def _counts(self):
-        return f"done {self.done}  failed {self.failed}  remaining {self.total - self.done - self.failed}"
+        return f"done {self.done}  failed {self.failed}  running {self._running()}  of {self.total}"
+
+    def running(self, n):
+        """The executor's count of runs in flight (without it: one per worker)."""
+        self.in_flight = n
+        if self.bar is not None:
+            self.bar.update(self.task, counts=self._counts())
 
     def update(self, rec):
         if rec["status"] == "completed":
@@ -126,31 +137,24 @@ class _Progress:
 
 def run_study(path, workers=2, executor="local", scheduler=None, force=False, output=None,
               quiet=False, storage=None):
-    """Run a study file; raises StudyError / ValueError before anything starts on bad input,
-    StudyLocked when another process works on the same folder. ``storage`` ("full" or
-    "compact") overrides the study file's [study] storage."""
-    if not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
-    executors.check_executor(executor, scheduler)
-    if storage is not None:
-        check_storage(storage)
-    study = load_study(path, output=output)
-    study.storage = storage or study.storage
-    # workers get absolute paths only: a relative one would land in each worker's own cwd
-    study.output = Path(os.path.abspath(study.output))
-    out = Outcome(study=study)
+    """Run a study (a study file, or a Study that load_study returned); raises StudyError /
+    ValueError before anything starts on bad input, StudyLocked when another process works on
+    the same folder. ``storage`` ("full" or "compact") overrides the study's [study] storage."""
     t0 = time.perf_counter()
+    study = _prepare(path, workers, executor, scheduler, output, storage)
+    executors.start_workers(executor, scheduler)   # they load while this process sets up
+    out = Outcome(study=study)
     with store.study_lock(study.output):
         store.clean_tmp(study.output)
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
         out.skipped = len(done)
-        progress = _Progress(len(tasks), len(done), quiet)
+        progress = _Progress(len(tasks), len(done), quiet, workers=workers)
         if executor == "dask":
             stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
         else:
-            stream = executors.run_local(tasks, workers, notify=progress.note)
+            stream = executors.run_local(tasks, workers, notify=progress.note, on_running=progress.running)
         try:
             if tasks:
                 for task, rec in stream:
@@ -166,6 +170,21 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
             _summarise(study, out)
     out.elapsed = time.perf_counter() - t0
     return out
+
+
+def _prepare(path, workers, executor, scheduler, output, storage):
+    """The study to run, its folder absolute, its storage decided; raises on bad input."""
+    if not isinstance(workers, int) or workers < 1:
+        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
+    executors.check_executor(executor, scheduler)
+    if storage is not None:
+        check_storage(storage)
+    study = path if isinstance(path, Study) and output is None else load_study(getattr(path, "source", path),
+                                                                               output=output)
+    # workers get absolute paths only: a relative one would land in each worker's own cwd
+    study.output = Path(os.path.abspath(study.output))
+    study.storage = storage or study.storage
+    return study
 
 
 def _summarise(study, out):
