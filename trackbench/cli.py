@@ -68,6 +68,12 @@ def study_run(
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
     study = _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
+    from .study.executors import check_arguments, start_workers
+    try:
+        check_arguments(workers, executor, scheduler, storage)
+    except ValueError as e:
+        _fail(str(e))
+    start_workers(executor, scheduler)   # the workers load while this process imports and sets up
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:

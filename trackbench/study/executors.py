@@ -288,16 +288,18 @@ def start_workers(executor="local", scheduler=None):
     """Start the fork server now (it loads in its own process while the command does its own
     set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler."""
     # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
-    # threads spin (seen at ~6 % of a core per worker); the fork server and the workers
-    # inherit this, and so start with a single thread (preload.py)
+    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
+    # pyarrow: the fork server and the workers inherit this, and so the server has a single
+    # thread when it forks (preload.py)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
+    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
     if scheduler:
         return
     ctx = _context()
     if ctx.get_start_method() == "forkserver":
         if executor == "dask":   # its nannies start worker processes from the same server
-            ctx.set_forkserver_preload([PRELOAD, "distributed"])
+            ctx.set_forkserver_preload(["distributed", PRELOAD])
         from multiprocessing import forkserver
         forkserver.ensure_running()
 
@@ -407,6 +409,16 @@ def run_dask(tasks, workers=2, scheduler=None, notify=None):
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def check_arguments(workers, executor, scheduler, storage):
+    """Raise ValueError (one line) on a bad worker count, executor or storage; nothing is started."""
+    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
+        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
+    check_executor(executor, scheduler)
+    if storage is not None:
+        from ..storage import check_storage
+        check_storage(storage)
 
 
 def check_executor(executor, scheduler):

@@ -2,19 +2,21 @@
 
 `study run` starts a fork server (multiprocessing's "forkserver": a fresh Python process
 started from the command, not a fork of it) with this module as its preload. Importing it
-imports the package, numpy, numba, xarray, pandas, netCDF4 and rerun, loads the compiled
-kernels from the numba cache by running a 1 ms simulation, and writes and reads back one
-small netCDF file (HDF5's set-up and the zstd filter plugin), all in a temporary folder. Each
-worker is then a fork of this process: it starts with all of that done instead of redoing it
-(about 2 s a worker).
+imports the package, numpy, numba, xarray, pandas and netCDF4, loads the compiled kernels
+from the numba cache by running a 1 ms simulation, and writes and reads back one small
+netCDF file (HDF5's set-up and the zstd filter plugin) in a temporary folder. Each worker
+is then a fork of this process: it starts with all of that done instead of redoing it.
 
-Why forking it is safe: the fork server runs a single thread from start to fork. numba's
+Why forking it is safe: the fork server has a single thread from start to fork, and a
+fork of a single-threaded process cannot inherit a lock held by another thread. numba's
 compiled code here uses no threading layer (no parallel=True), so it starts no thread; no
-file is left open; no rerun recording stream (which runs threads) is created here, only its
-module imported; BLAS is limited to one thread (OPENBLAS_NUM_THREADS=1, set by the command
-before the server starts, so no BLAS thread pool exists). THREADS_AT_FORK records the
-number of threads the process had at the end of the preload (1), and a worker can report
-it. The command itself, which may run threads (the progress display, dask's scheduler), is
+file is left open. Three libraries would start threads, so the command sets, before the
+server starts: OPENBLAS_NUM_THREADS=1 (no BLAS thread pool) and
+JE_ARROW_MALLOC_CONF=background_thread:false (pyarrow, which pandas imports, would start
+jemalloc's background thread); and rerun is not imported here: its import starts a tokio
+runtime with worker threads, so each worker imports it at its first recording. THREADS_AT_FORK
+records the thread count at the end of the preload (1; a test checks it through a worker).
+The command itself, which may run threads (the progress display, dask's scheduler), is
 never forked.
 """
 
@@ -36,22 +38,28 @@ def warm():
     from pathlib import Path
 
     import netCDF4
-    import pandas  # noqa: F401  (imported by the summary of a run's results)
-    import rerun  # noqa: F401  (import only: a recording stream starts threads)
+    import pandas  # noqa: F401  (the summary of a run's results)
     import xarray
 
     import trackbench
-    from trackbench.replay import record  # noqa: F401
-    from trackbench.study import executors  # noqa: F401
+    from trackbench.output import write_netcdf
+    from trackbench.study import executors
 
     xarray.backends.list_engines()
     ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
     executors.run_summary(ds)
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "warm.nc"
-        trackbench.output.write_netcdf(ds, path)
+        write_netcdf(ds, path)
         with netCDF4.Dataset(path) as f:
             f.getncattr("status")
+
+
+def facts():
+    """What a worker inherited (for tests and diagnosis): its pid, the fork server's thread
+    count at the end of the preload, and how many compiled signatures the time loop has."""
+    from trackbench.solvers.reduced import integrate
+    return {"pid": os.getpid(), "threads_at_fork": THREADS_AT_FORK, "loop_signatures": len(integrate.signatures)}
 
 
 try:

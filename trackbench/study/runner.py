@@ -11,7 +11,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import executors, store
-from ..storage import check_storage
 from .spec import Study, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
@@ -82,9 +81,9 @@ class _Progress:
     """A live rich progress bar on a terminal (done, failed, running, elapsed, ETA); one plain
     line per finished run otherwise (a log, a pipe, CI)."""
 
-    def __init__(self, total, skipped, quiet=False, stream=None, workers=1):
+    def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None):
         from rich.console import Console
-        self.console = Console(file=stream or sys.stderr)
+        self.console = Console(file=stream or sys.stderr, force_terminal=terminal)
         self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
         self.quiet, self.t0 = quiet, time.perf_counter()
         self.bar = None
@@ -174,11 +173,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
 
 def _prepare(path, workers, executor, scheduler, output, storage):
     """The study to run, its folder absolute, its storage decided; raises on bad input."""
-    if not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
-    executors.check_executor(executor, scheduler)
-    if storage is not None:
-        check_storage(storage)
+    executors.check_arguments(workers, executor, scheduler, storage)
     study = path if isinstance(path, Study) and output is None else load_study(getattr(path, "source", path),
                                                                                output=output)
     # workers get absolute paths only: a relative one would land in each worker's own cwd
