@@ -230,18 +230,23 @@ def part_large(cwd, n=200):
 
 
 def part_summary_time(out, n):
+    """write_summary (summary.csv + .parquet from every run.json) for the first n/8 .. n runs,
+    best of 5, and the straight line a + b x runs through them."""
     from trackbench.study.summary import _study_of, write_summary
     study = _study_of(out)
-    runs, line = study.runs, []
-    for k in (n // 8, n // 4, n // 2, n):
+    runs, ks, best = study.runs, [n // 8, n // 4, n // 2, n], []
+    for k in ks:
         study.runs = runs[:k]
         times = []
-        for _ in range(3):
+        for _ in range(5):
             t = time.perf_counter()
             write_summary(study)
             times.append(time.perf_counter() - t)
-        line.append(f"{k} runs {1e3 * min(times):.0f} ms ({1e3 * min(times) / k:.2f} ms/run)")
-    print("write_summary (summary.csv + .parquet from the runs' run.json), best of 3: " + "; ".join(line))
+        best.append(min(times))
+    b, a = np.polyfit(ks, best, 1)
+    worst = max(abs(a + b * k - t) / t for k, t in zip(ks, best))
+    print("write_summary, best of 5: " + "; ".join(f"{k} runs {1e3 * t:.0f} ms" for k, t in zip(ks, best))
+          + f"; line {1e3 * a:.0f} ms + {1e3 * b:.2f} ms per run (largest deviation {100 * worst:.0f} %)")
 
 
 def main():
