@@ -112,3 +112,13 @@ def test_study_with_compact_storage_has_the_same_summary(tmp_path):
         for name in ("timeseries.nc", "recording.rrd"):
             assert (c / name).stat().st_size < (f / name).stat().st_size, name   # (short runs: mostly headers)
     assert "storage = \"compact\"" in (tmp_path / "c" / "study.toml").read_text()
+
+
+def test_run_command_with_compact_storage(tmp_path):
+    r = subprocess.run([sys.executable, "-c", "from trackbench.cli import main; main()", "run", "--storage", "compact",
+                        "--duration", "0.05", "--set", "output_interval=0.001", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    with xr.open_dataset(tmp_path / "paper_step.nc") as ds:
+        assert ds.attrs["storage"] == "compact" and ds.pin_x.encoding["dtype"] == np.int32
+    assert (tmp_path / "paper_step.rrd").stat().st_size > 0
