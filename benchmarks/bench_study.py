@@ -3,8 +3,8 @@
     python benchmarks/bench_study.py [--repeat 5] [--parts sweep,storage,dask,large]
                                      [--reference RESULTS_DIR]
 
-Every figure is a whole `trackbench study run` command in a fresh process (as a user runs
-it), the numba cache warm (one warm-up command first). The machine may be shared, so the
+Every figure is a whole `trackbench study run` command in a fresh process on a fresh results
+folder (as a user runs it), the numba cache warm (one warm-up command first). The machine may be shared, so the
 commands compared are alternated run by run and the medians compared.
 
 sweep    the shipped studies/speed_sweep.toml (15 runs of 0.5 s) with 1 and 2 workers:
@@ -42,9 +42,11 @@ sys.path.insert(0, str(REPO))
 
 
 def command(cwd, study, *args):
-    """Run `trackbench study run STUDY --force ARGS` in ``cwd``; returns its wall time (s)."""
+    """Run `trackbench study run STUDY ARGS` in ``cwd`` on a fresh results folder (a user's
+    first run: no file replaced); returns its wall time (s)."""
+    shutil.rmtree(cwd / "results" / Path(study).stem, ignore_errors=True)
     t = time.perf_counter()
-    r = subprocess.run(CLI + ["study", "run", study, "--force", *args], cwd=cwd, stdout=subprocess.DEVNULL,
+    r = subprocess.run(CLI + ["study", "run", study, *args], cwd=cwd, stdout=subprocess.DEVNULL,
                        stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t
     if r.returncode != 0:
@@ -212,7 +214,8 @@ def part_large(cwd, n=200):
     (cwd / "large.toml").write_text(LARGE.format(stop=round(5.0 + 0.05 * (n - 1), 2)))
     out = cwd / "results" / "large"
     t = time.perf_counter()
-    proc = subprocess.Popen(CLI + ["study", "run", "large.toml", "--force"], cwd=cwd, stdout=subprocess.DEVNULL,
+    shutil.rmtree(out, ignore_errors=True)
+    proc = subprocess.Popen(CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     rows = sample_memory(proc, out)
     wall = time.perf_counter() - t
