@@ -213,8 +213,8 @@ def sample_memory(proc, out, every=0.2):
 def part_large(cwd, n=200):
     (cwd / "large.toml").write_text(LARGE.format(stop=round(5.0 + 0.05 * (n - 1), 2)))
     out = cwd / "results" / "large"
-    t = time.perf_counter()
     shutil.rmtree(out, ignore_errors=True)
+    t = time.perf_counter()
     proc = subprocess.Popen(CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
     rows = sample_memory(proc, out)
