@@ -64,11 +64,39 @@ def overhead(recs):
     return statistics.median(r), max(r), sum(x["solve_time"] for x in recs)
 
 
+def idle_fraction(seconds=2.0):
+    """The machine's idle CPU fraction over ``seconds`` (Linux /proc/stat), or None."""
+    try:
+        a = [int(x) for x in open("/proc/stat").readline().split()[1:]]
+        time.sleep(seconds)
+        b = [int(x) for x in open("/proc/stat").readline().split()[1:]]
+    except OSError:
+        return None
+    d = [y - x for x, y in zip(a, b)]
+    return (d[3] + d[4]) / max(sum(d), 1)
+
+
+def wait_quiet(limit):
+    """Wait (at most ``limit`` s) until the machine is 90 % idle over 2 s: other jobs on a
+    shared machine take a core from the 2-worker case. Returns the idle fraction last seen."""
+    t0, idle = time.time(), None
+    while time.time() - t0 < limit:
+        idle = idle_fraction()
+        if idle is None or idle > 0.9:
+            break
+    return idle
+
+
+QUIET = {"limit": 0.0, "seen": []}
+
+
 def alternate(repeat, cases):
-    """Run each case (name -> function returning a dict) in turn, ``repeat`` times; returns
-    name -> list of results."""
+    """Run each case (name -> function returning a dict) in turn, ``repeat`` times (with
+    --quiet-wait, each round once the machine is idle); returns name -> list of results."""
     out = {name: [] for name in cases}
     for _ in range(repeat):
+        if QUIET["limit"]:
+            QUIET["seen"].append(wait_quiet(QUIET["limit"]))
         for name, fn in cases.items():
             out[name].append(fn())
     return out
@@ -257,7 +285,10 @@ def main():
     ap.add_argument("--repeat", type=int, default=5, help="alternating repeats of each comparison")
     ap.add_argument("--parts", default="sweep,storage,dask,large")
     ap.add_argument("--reference", help="results folder of the speed sweep from another version (bit for bit)")
+    ap.add_argument("--quiet-wait", type=float, default=0.0,
+                    help="before each round, wait up to this many seconds for an idle machine")
     args = ap.parse_args()
+    QUIET["limit"] = args.quiet_wait
     parts = args.parts.split(",")
     print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
@@ -274,7 +305,9 @@ def main():
             part_dask(cwd, args.repeat)
         if "large" in parts:
             part_large(cwd)
-    print(f"load average after: {os.getloadavg()[0]:.2f}")
+    seen = [f"{x:.2f}" for x in QUIET["seen"] if x is not None]
+    print(f"load average after: {os.getloadavg()[0]:.2f}" + (f"; idle fraction before each round: {', '.join(seen)}"
+                                                             if seen else ""))
 
 
 if __name__ == "__main__":
