@@ -73,7 +73,9 @@ def study_run(
         check_arguments(workers, executor, scheduler, storage)
     except ValueError as e:
         _fail(str(e))
-    start_workers(executor, scheduler)   # the workers load while this process imports and sets up
+    from .study import store
+    if force or not all(store.is_completed(study.output, r.run_id) for r in study.runs):
+        start_workers(executor, scheduler)   # the workers load while this process imports and sets up
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:

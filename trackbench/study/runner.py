@@ -141,13 +141,14 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
     the same folder. ``storage`` ("full" or "compact") overrides the study's [study] storage."""
     t0 = time.perf_counter()
     study = _prepare(path, workers, executor, scheduler, output, storage)
-    executors.start_workers(executor, scheduler)   # they load while this process sets up
     out = Outcome(study=study)
     with store.study_lock(study.output):
         store.clean_tmp(study.output)
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
+        if tasks:
+            executors.start_workers(executor, scheduler)   # they load while this process sets up
         out.skipped = len(done)
         progress = _Progress(len(tasks), len(done), quiet, workers=workers)
         if executor == "dask":
