@@ -1,84 +1,313 @@
-"""Study benchmark: the same 8-run study with 2 workers against 1, in one process.
+"""Study benchmark: whole commands, per-run overhead, storage, dask, a 200-run study.
 
-    python benchmarks/bench_study.py [--duration 0.5]
+    python benchmarks/bench_study.py [--repeat 5] [--parts sweep,storage,dask,large]
+                                     [--reference RESULTS_DIR]
 
-Alternates 1 and 2 workers --repeat times (the machine may be shared) and keeps the
-fastest of each. Prints the speed-up (whole command, and with the workers' start-up left out) and the
-overhead outside the solver (ds.attrs['solve_time']) as % of the solve time: per run inside
-the worker (equilibrium, dataset, netCDF, run.json), and for the whole study (expansion,
-pool start-up, storage, summary). Recording is off (it is the replay issue's cost).
+Every figure is a whole `trackbench study run` command in a fresh process on a fresh results
+folder (as a user runs it), the numba cache warm (one warm-up command first). The machine may be shared, so the
+commands compared are alternated run by run and the medians compared.
+
+sweep    the shipped studies/speed_sweep.toml (15 runs of 0.5 s) with 1 and 2 workers:
+         whole-command speed-up, sum of the solve times / (2 x wall) with 2 workers, and the
+         per-run overhead outside the solve from run.json ((wall_time - solve_time) / solve_time)
+storage  the same sweep with --storage compact: the largest run folder full / compact / as
+         written before (xarray, uncompressed: rebuilt from the full files), and the time of
+         open_study and of open_study_dataset + loading chassis_y on the three
+--reference  compare the sweep's summary.csv numbers and every array of every timeseries.nc
+         bit for bit with a results folder of the same sweep written by another version
+dask     the sweep on a dask LocalCluster of 2 worker processes against the process pool
+large    200 runs of 0.5 s (speeds 5.00 .. 14.95 m/s, recordings off): runs per second, the
+         command's memory as runs accumulate, write_summary time for 25 .. 200 runs
 """
 
 import argparse
+import json
 import os
+import shutil
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
 
-from trackbench.study import load_study, run_study, store
-from trackbench.study.summary import write_summary
+import numpy as np
+import pandas as pd
 
-STUDY = """[study]
-name = "bench"
+REPO = Path(__file__).resolve().parents[1]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+# the commands run this checkout's trackbench
+os.environ["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
+sys.path.insert(0, str(REPO))
+
+
+def command(cwd, study, *args):
+    """Run `trackbench study run STUDY ARGS` in ``cwd`` on a fresh results folder (a user's
+    first run: no file replaced); returns its wall time (s)."""
+    shutil.rmtree(cwd / "results" / Path(study).stem, ignore_errors=True)
+    t = time.perf_counter()
+    r = subprocess.run(CLI + ["study", "run", study, *args], cwd=cwd, stdout=subprocess.DEVNULL,
+                       stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t
+    if r.returncode != 0:
+        raise SystemExit(f"study run {study} {' '.join(args)} failed: {r.stderr[-2000:]}")
+    return wall
+
+
+def records(folder):
+    return [json.loads(p.read_text()) for p in sorted(Path(folder).glob("runs/*/run.json"))]
+
+
+def overhead(recs):
+    """(median, max) of (wall_time - solve_time) / solve_time over the runs, and the solve total."""
+    r = [(x["wall_time"] - x["solve_time"]) / x["solve_time"] for x in recs]
+    return statistics.median(r), max(r), sum(x["solve_time"] for x in recs)
+
+
+def idle_fraction(seconds=2.0):
+    """The machine's idle CPU fraction over ``seconds`` (Linux /proc/stat), or None."""
+    try:
+        a = [int(x) for x in open("/proc/stat").readline().split()[1:]]
+        time.sleep(seconds)
+        b = [int(x) for x in open("/proc/stat").readline().split()[1:]]
+    except OSError:
+        return None
+    d = [y - x for x, y in zip(a, b)]
+    return (d[3] + d[4]) / max(sum(d), 1)
+
+
+def wait_quiet(limit):
+    """Wait (at most ``limit`` s) until the machine is 90 % idle over 2 s: other jobs on a
+    shared machine take a core from the 2-worker case. Returns the idle fraction last seen."""
+    t0, idle = time.time(), None
+    while time.time() - t0 < limit:
+        idle = idle_fraction()
+        if idle is None or idle > 0.9:
+            break
+    return idle
+
+
+QUIET = {"limit": 0.0, "seen": []}
+
+
+def alternate(repeat, cases):
+    """Run each case (name -> function returning a dict) in turn, ``repeat`` times (with
+    --quiet-wait, each round once the machine is idle); returns name -> list of results."""
+    out = {name: [] for name in cases}
+    for _ in range(repeat):
+        if QUIET["limit"]:
+            QUIET["seen"].append(wait_quiet(QUIET["limit"]))
+        for name, fn in cases.items():
+            out[name].append(fn())
+    return out
+
+
+def sweep_case(cwd, workers, extra=()):
+    def fn():
+        wall = command(cwd, "speed_sweep.toml", "-w", str(workers), *extra)
+        med, worst, solve = overhead(records(cwd / "results" / "speed_sweep"))
+        return {"wall": wall, "solve": solve, "med": med, "max": worst}
+    return fn
+
+
+def med(results, key):
+    return statistics.median(r[key] for r in results)
+
+
+def part_sweep(cwd, repeat):
+    res = alternate(repeat, {1: sweep_case(cwd, 1), 2: sweep_case(cwd, 2)})
+    ratios = [a["wall"] / b["wall"] for a, b in zip(res[1], res[2])]
+    eff = [b["solve"] / (2 * b["wall"]) for b in res[2]]
+    print(f"\n== speed_sweep, whole command, {repeat} alternating pairs (median [min, max])")
+    for w in (1, 2):
+        walls = [r["wall"] for r in res[w]]
+        print(f"{w} worker{'s' if w > 1 else ' '}: {statistics.median(walls):.2f} s [{min(walls):.2f}, {max(walls):.2f}]; "
+              f"solve total {med(res[w], 'solve'):.2f} s; per-run overhead outside the solve (run.json): "
+              f"median {100 * med(res[w], 'med'):.0f} %, largest {100 * max(r['max'] for r in res[w]):.0f} %")
+    print(f"speed-up 2 vs 1 workers: median {statistics.median(ratios):.2f}x [{min(ratios):.2f}, {max(ratios):.2f}] "
+          f"(target >= 1.8x)")
+    print(f"sum of solve times / (2 x wall), 2 workers: median {statistics.median(eff):.2f} "
+          f"[{min(eff):.2f}, {max(eff):.2f}] (target >= 0.4)")
+
+
+def folder_bytes(run):
+    return sum(p.stat().st_size for p in run.iterdir() if p.is_file())
+
+
+def as_before(src, dst):
+    """A copy of the study folder ``src`` whose timeseries.nc are written as before trackbench.storage
+    (xarray's to_netcdf, uncompressed): the yardstick for size and reading time."""
+    import xarray as xr
+    shutil.copytree(src, dst)
+    for p in dst.glob("runs/*/timeseries.nc"):
+        ds = xr.load_dataset(p).drop_encoding()
+        ds.attrs.pop("storage", None)
+        ds.to_netcdf(p, engine="netcdf4", encoding={k: {"_FillValue": None} for k in ds.coords})
+
+
+def reading_case(folder):
+    import trackbench as tb
+
+    def fn():
+        t = time.perf_counter()
+        tb.open_study(folder)
+        t1 = time.perf_counter()
+        ds = tb.open_study_dataset(folder)
+        ds.chassis_y.load()
+        ds.close()
+        return {"summary": t1 - t, "dataset": time.perf_counter() - t1}
+    return fn
+
+
+def part_storage(cwd, repeat):
+    results, full, compact = cwd / "results" / "speed_sweep", cwd / "full", cwd / "compact"
+    for folder, storage in ((full, "full"), (compact, "compact")):
+        command(cwd, "speed_sweep.toml", "-w", "2", "--storage", storage)
+        shutil.rmtree(folder, ignore_errors=True)
+        shutil.copytree(results, folder)
+    before = cwd / "before"
+    shutil.rmtree(before, ignore_errors=True)
+    as_before(full, before)
+    print("\n== storage of the speed sweep (largest run folder; whole study)")
+    for name, folder in (("before (xarray, uncompressed)", before), ("full (default)", full), ("compact", compact)):
+        sizes = [folder_bytes(r) for r in folder.glob("runs/*")]
+        nc = max(p.stat().st_size for p in folder.glob("runs/*/timeseries.nc"))
+        rrd = max((p.stat().st_size for p in folder.glob("runs/*/recording.rrd")), default=0)
+        print(f"{name:30s} largest folder {max(sizes) / 1e6:.2f} MB (timeseries.nc up to {nc / 1e6:.2f} MB, "
+              f"recording up to {rrd / 1e6:.2f} MB); study {sum(sizes) / 1e6:.0f} MB")
+    res = alternate(repeat, {"before": reading_case(before), "full": reading_case(full), "compact": reading_case(compact)})
+    print(f"reading, median of {repeat} alternating: open_study / open_study_dataset + chassis_y.load()")
+    for name in res:
+        print(f"  {name:8s} {1e3 * med(res[name], 'summary'):6.1f} ms / {1e3 * med(res[name], 'dataset'):6.1f} ms")
+    return full
+
+
+def compare(a, b):
+    """Differences between the sweep's results in folders a and b (summary numbers, arrays)."""
+    import xarray as xr
+    da, db = pd.read_csv(a / "summary.csv"), pd.read_csv(b / "summary.csv")
+    if list(da.run_id) != list(db.run_id):
+        return ["the run ids differ"]
+    bad = [f"summary.csv {c}" for c in da.columns if c not in ("wall_time", "solve_time") and not da[c].equals(db[c])]
+    for rid in da.run_id:
+        x, y = (xr.load_dataset(f / "runs" / rid / "timeseries.nc") for f in (a, b))
+        if set(x.variables) != set(y.variables):
+            bad.append(f"{rid}: variables differ")
+        bad += [f"{rid} {k}" for k in x.variables if k in y.variables and not (
+            x[k].dtype == y[k].dtype and np.array_equal(x[k].values, y[k].values, equal_nan=True))]
+    return bad
+
+
+def part_reference(cwd, reference):
+    full = cwd / "results" / "speed_sweep"
+    command(cwd, "speed_sweep.toml", "-w", "2")
+    bad = compare(Path(reference), full)
+    print(f"\n== results against {reference}: " + ("summary numbers and every array bit for bit the same"
+                                                     if not bad else f"{len(bad)} differences: {bad[:10]}"))
+
+
+def part_dask(cwd, repeat):
+    res = alternate(repeat, {"pool": sweep_case(cwd, 2), "dask": sweep_case(cwd, 2, ("--executor", "dask"))})
+    ratios = [d["wall"] / p["wall"] for p, d in zip(res["pool"], res["dask"])]
+    print(f"\n== dask LocalCluster (2 worker processes) against the process pool (2 workers), {repeat} pairs")
+    print(f"pool {med(res['pool'], 'wall'):.2f} s, dask {med(res['dask'], 'wall'):.2f} s: dask / pool median "
+          f"{statistics.median(ratios):.2f} [{min(ratios):.2f}, {max(ratios):.2f}] (target <= 1.3)")
+
+
+LARGE = """[study]
+name = "large"
 [scenario]
-duration = {duration}
+duration = 0.5
 record = {{ enabled = false }}
 [grid]
-speed = [6.0, 8.0, 10.0, 12.0]
-"terrain.height" = [0.1, 0.15]
+speed = {{ start = 5.0, stop = {stop}, step = 0.05 }}
 """
 
 
-def one(path, out, workers):
-    o = run_study(path, workers=workers, output=out, force=True, quiet=True)
-    recs = [store.read_run(out, rid) for rid in o.summary.run_id]
-    assert all(r["status"] == "completed" for r in recs), "benchmark runs must complete"
-    solve = sum(r["solve_time"] for r in recs)
-    inside = sum(r["wall_time"] for r in recs)
-    steady = max(r["finished_unix"] for r in recs) - min(r["started_unix"] for r in recs)
-    return {"elapsed": o.elapsed, "solve": solve, "inside": inside, "steady": steady,
-            "per_run_solve": statistics.mean(r["solve_time"] for r in recs)}
+def sample_memory(proc, out, every=0.2):
+    """(seconds, runs finished, RSS of the command in MB) while ``proc`` runs."""
+    import psutil
+    p, rows, t0 = psutil.Process(proc.pid), [], time.perf_counter()
+    while proc.poll() is None:
+        try:
+            rss = p.memory_info().rss / 1e6
+        except psutil.Error:
+            break
+        rows.append((time.perf_counter() - t0, len(list(out.glob("runs/*/run.json"))), rss))
+        time.sleep(every)
+    return rows
+
+
+def part_large(cwd, n=200):
+    (cwd / "large.toml").write_text(LARGE.format(stop=round(5.0 + 0.05 * (n - 1), 2)))
+    out = cwd / "results" / "large"
+    shutil.rmtree(out, ignore_errors=True)
+    t = time.perf_counter()
+    proc = subprocess.Popen(CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    rows = sample_memory(proc, out)
+    wall = time.perf_counter() - t
+    recs = records(out)
+    span = max(r["finished_unix"] for r in recs) - min(r["started_unix"] for r in recs)
+    med_o, max_o, solve = overhead(recs)
+    print(f"\n== {n}-run study (0.5 s runs, 2 workers, recordings off): exit {proc.returncode}, {len(recs)} runs")
+    print(f"whole command {wall:.1f} s: {n / wall:.2f} runs/s; first run start to last run end {span:.1f} s: "
+          f"{n / span:.2f} runs/s; solve total {solve:.1f} s (sum / (2 x wall) = {solve / (2 * wall):.2f}); "
+          f"per-run overhead median {100 * med_o:.0f} %")
+    marks = [rows[min(range(len(rows)), key=lambda i: abs(rows[i][1] - k))] for k in (n // 10, n // 2, n * 9 // 10)]
+    print("memory of the command (main process) as runs accumulate: " + ", ".join(
+        f"{r[1]} runs {r[2]:.0f} MB" for r in marks) + f"; peak {max(r[2] for r in rows):.0f} MB")
+    part_summary_time(out, n)
+
+
+def part_summary_time(out, n):
+    """write_summary (summary.csv + .parquet from every run.json) for the first n/8 .. n runs,
+    best of 5, and the straight line a + b x runs through them."""
+    from trackbench.study.summary import _study_of, write_summary
+    study = _study_of(out)
+    runs, ks, best = study.runs, [n // 8, n // 4, n // 2, n], []
+    for k in ks:
+        study.runs = runs[:k]
+        times = []
+        for _ in range(5):
+            t = time.perf_counter()
+            write_summary(study)
+            times.append(time.perf_counter() - t)
+        best.append(min(times))
+    b, a = np.polyfit(ks, best, 1)
+    worst = max(abs(a + b * k - t) / t for k, t in zip(ks, best))
+    print("write_summary, best of 5: " + "; ".join(f"{k} runs {1e3 * t:.0f} ms" for k, t in zip(ks, best))
+          + f"; line {1e3 * a:.0f} ms + {1e3 * b:.2f} ms per run (largest deviation {100 * worst:.0f} %)")
 
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--duration", type=float, default=0.5)
-    ap.add_argument("--repeat", type=int, default=3, help="alternate 1 and 2 workers this often, keep the best")
+    ap.add_argument("--repeat", type=int, default=5, help="alternating repeats of each comparison")
+    ap.add_argument("--parts", default="sweep,storage,dask,large")
+    ap.add_argument("--reference", help="results folder of the speed sweep from another version (bit for bit)")
+    ap.add_argument("--quiet-wait", type=float, default=0.0,
+                    help="before each round, wait up to this many seconds for an idle machine")
     args = ap.parse_args()
-    load0 = os.getloadavg()[0]
+    QUIET["limit"] = args.quiet_wait
+    parts = args.parts.split(",")
+    print(f"load average before: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory() as tmp:
-        path = Path(tmp) / "bench.toml"
-        path.write_text(STUDY.format(duration=args.duration))
-        t = time.perf_counter()
-        study = load_study(path, output=Path(tmp) / "out1")
-        t_expand = time.perf_counter() - t
-        one(path, Path(tmp) / "warm", 2)  # numba cache on disk, page cache warm
-        r1 = r2 = None
-        for _ in range(args.repeat):  # the machine is shared: alternate, keep the fastest of each
-            a = one(path, Path(tmp) / "out1", 1)
-            b = one(path, Path(tmp) / "out2", 2)
-            r1 = a if r1 is None or a["elapsed"] < r1["elapsed"] else r1
-            r2 = b if r2 is None or b["elapsed"] < r2["elapsed"] else r2
-        t = time.perf_counter()
-        write_summary(study)
-        t_summary = time.perf_counter() - t
-    n = 8
-    print(f"load average before: {load0:.2f}, after: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores"
-          + ("  (the machine is busy: the speed-up is not meaningful)" if load0 > 0.5 else ""))
-    print(f"best of {args.repeat} alternating repeats; study: 8 runs of {args.duration} s (paper vehicle, step), mean solve time "
-          f"{r1['per_run_solve']:.3f} s per run")
-    print(f"1 worker : {r1['elapsed']:.2f} s whole command, {r1['steady']:.2f} s first run start -> last run end")
-    print(f"2 workers: {r2['elapsed']:.2f} s whole command, {r2['steady']:.2f} s first run start -> last run end")
-    print(f"speed-up 2 vs 1: {r1['elapsed'] / r2['elapsed']:.2f}x whole command, "
-          f"{r1['steady'] / r2['steady']:.2f}x without worker start-up")
-    inside = 100 * (r1["inside"] - r1["solve"]) / r1["solve"]
-    whole = 100 * (r1["elapsed"] - r1["solve"]) / r1["solve"]
-    print(f"overhead outside the solver, 1 worker, as % of solve time:")
-    print(f"  per run in the worker (equilibrium, dataset, netCDF, run.json): {inside:.1f} %  "
-          f"({(r1['inside'] - r1['solve']) / n * 1e3:.0f} ms per run)")
-    print(f"  whole study (plus expansion, pool start-up, summary):            {whole:.1f} %")
-    print(f"  expansion + validation of 8 runs {t_expand * 1e3:.0f} ms; summary {t_summary * 1e3:.0f} ms")
+        cwd = Path(tmp)
+        shutil.copy(REPO / "studies" / "speed_sweep.toml", cwd / "speed_sweep.toml")
+        command(cwd, "speed_sweep.toml", "-w", "2")   # warm-up: numba cache and page cache
+        if "sweep" in parts:
+            part_sweep(cwd, args.repeat)
+        if "storage" in parts:
+            part_storage(cwd, args.repeat)
+        if args.reference:
+            part_reference(cwd, args.reference)
+        if "dask" in parts:
+            part_dask(cwd, args.repeat)
+        if "large" in parts:
+            part_large(cwd)
+    seen = [f"{x:.2f}" for x in QUIET["seen"] if x is not None]
+    print(f"load average after: {os.getloadavg()[0]:.2f}" + (f"; idle fraction before each round: {', '.join(seen)}"
+                                                             if seen else ""))
 
 
 if __name__ == "__main__":

@@ -330,7 +330,7 @@ def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
 
 # --- 4. disk full and other reasons a user can act on -----------------------------------------
 
-def _serial(tasks, workers=2, notify=None):
+def _serial(tasks, workers=2, notify=None, on_running=None):
     """The local executor without its process pool, so that monkeypatches reach the worker code."""
     for t in tasks:
         t = executors._attempt(t, 1)
@@ -343,11 +343,11 @@ def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tm
     real = store.write_timeseries
     victim = load_study(p, output=out).runs[1].run_id
 
-    def write(ds, path, compress=False):
+    def write(ds, path, storage="full"):
         if Path(path).parent.name == victim:
             Path(path).with_name(".timeseries.nc.x.tmp").write_bytes(b"half")  # cleaned by the coordinator
             raise OSError(errno.ENOSPC, "No space left on device")
-        return real(ds, path, compress)
+        return real(ds, path, storage)
     monkeypatch.setattr(executors, "run_local", _serial)
     monkeypatch.setattr(store, "write_timeseries", write)
     o = run_study(p, output=out, quiet=True)
@@ -370,7 +370,7 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
     run = s.runs[0]
     task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}}
 
-    def hdf(ds, path, compress=False):
+    def hdf(ds, path, storage="full"):
         raise RuntimeError("NetCDF: HDF error")
     monkeypatch.setattr(store, "write_timeseries", hdf)
     rec = executors.execute_run(task)          # plenty of space: the error as it is
@@ -397,14 +397,14 @@ def test_reasons_for_permission_and_missing_paths():
 
 @needs_unshare
 def test_real_full_disk_then_rerun_with_space(tmp_path):
-    """A 1.5 MB file system for 4 runs of about 0.55 MB each: the runs that do not fit fail
+    """A 0.8 MB file system for 4 runs of about 0.32 MB each: the runs that do not fit fail
     saying the disk is full; once the file system is larger, a rerun completes exactly those."""
     scen = 'duration = 0.05\nrecord = { enabled = false }\n'
     p = write_study(tmp_path, "full", speeds=(5.0, 6.0, 7.0, 8.0), scenario=scen)
     out, keep = tmp_path / "results" / "full", tmp_path / "kept"
     out.mkdir(parents=True)
     run = f"{sys.executable} -c 'from trackbench.cli import main; main()' study run {p} --workers 2"
-    script = (f"mount -t tmpfs -o size=1500k tmpfs {out} || exit 99; "
+    script = (f"mount -t tmpfs -o size=800k tmpfs {out} || exit 99; "
               f"{run} > {tmp_path}/1.out 2> {tmp_path}/1.err; echo $? > {tmp_path}/1.rc; "
               f"cp -r {out} {tmp_path}/first; "
               f"mount -o remount,size=20m {out}; "

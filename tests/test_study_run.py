@@ -245,7 +245,7 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     from trackbench.study.executors import execute_run
     mod = types.ModuleType("trackbench.replay.record")
 
-    def boom(ds, path, every=1):
+    def boom(ds, path, every=1, signal_every=1):
         Path(path).write_text("partial")
         raise RuntimeError("disk full")
     mod.write_recording = boom
@@ -258,7 +258,7 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     assert rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]
     assert sorted(os.listdir(store.run_dir(s.output, run.run_id))) == ["run.json", "timeseries.nc"]
 
-    def ok(ds, path, every=1):
+    def ok(ds, path, every=1, signal_every=1):
         Path(path).write_text(f"rrd every={every}")
     mod.write_recording = ok
     rec = execute_run(task)
@@ -271,3 +271,38 @@ def _write(tmp_path, text):
     p = tmp_path / "x.toml"
     p.write_text(text)
     return p
+
+
+def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
+    import io
+    from trackbench.study.runner import _Progress
+    runs = [{"run_id": "a1", "status": "completed"}, {"run_id": "b2", "status": "failed", "status_message": "NaN"},
+            {"run_id": "c3", "status": "completed"}]
+    log = io.StringIO()
+    p = _Progress(3, 1, stream=log, workers=2)
+    for r in runs:
+        p.update(r)
+    p.close()
+    lines = log.getvalue().splitlines()
+    assert lines[0] == "3 runs to do, 1 already completed" and len(lines) == 4 and "\x1b" not in log.getvalue()
+    assert lines[2].startswith("[2/3] b2 failed: NaN  (done 1  failed 1  running 1  of 3, ETA")
+    term = io.StringIO()
+    p = _Progress(3, 0, stream=term, workers=2, terminal=True)
+    p.running(2)
+    p.update(runs[0])
+    p.close()
+    out = term.getvalue()
+    assert "\x1b" in out and "done 1  failed 0  running 2  of 3" in out and "ETA" in out and "[1/3]" not in out
+
+
+def test_workers_are_forks_of_a_single_threaded_preloaded_server():
+    """The pool's workers come from the fork server: the kernels already loaded there, which had
+    one thread when it forked (trackbench/study/preload.py says why that makes forking safe)."""
+    from trackbench.study import executors
+    from trackbench.study.preload import facts
+    pool = executors._new_pool(2)
+    try:
+        got = [f.result(timeout=300) for f in [pool.submit(facts) for _ in range(2)]]
+    finally:
+        pool.shutdown()
+    assert all(g["threads_at_fork"] == 1 and g["loop_signatures"] >= 1 and g["pid"] != os.getpid() for g in got)

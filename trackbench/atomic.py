@@ -38,5 +38,6 @@ def atomic_path(path):
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
+            os.truncate(tmp, 0)   # frees its space even when a failed writer still holds it open
             os.remove(tmp)
         raise

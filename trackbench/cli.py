@@ -23,12 +23,14 @@ def run(
     out: Path = typer.Option(Path("out"), "--out", "-o", help="Folder for the netCDF file."),
     name: str = typer.Option("paper_step", help="Scenario name, used for the file name."),
     force: bool = typer.Option(False, "--force", help="Replace OUT/NAME.nc (and .rrd) if they exist."),
+    storage: str = typer.Option("full", help="full (lossless) or compact (time histories at the resolution "
+                                             "results_schema.md states, a thinner recording)."),
 ):
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
     from .runner import run_one
     from .scenario import ScenarioError
     try:
-        text, ok = run_one(set_, duration, out, name, force)
+        text, ok = run_one(set_, duration, out, name, force, storage)
     except ScenarioError as e:
         _fail(str(e))
     typer.echo(text)
@@ -60,13 +62,25 @@ def study_run(
     executor: str = typer.Option("local", help="local (process pool) or dask (dask.distributed)."),
     scheduler: Optional[str] = typer.Option(None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."),
     force: bool = typer.Option(False, "--force", help="Rerun every run, also those already completed."),
+    storage: Optional[str] = typer.Option(None, help="full (lossless) or compact (time histories at the resolution "
+                                                     "results_schema.md states); default: the study's [study] storage, "
+                                                     "else full. Runs already completed keep their files."),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
+    study = _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
+    from .study.executors import check_arguments, start_workers
+    try:
+        check_arguments(workers, executor, scheduler, storage)
+    except ValueError as e:
+        _fail(str(e))
+    from .study import store
+    if force or not all(store.is_completed(study.output, r.run_id) for r in study.runs):
+        start_workers(executor, scheduler)   # the workers load while this process imports and sets up
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:
-        outcome = run_study(file, workers=workers, executor=executor, scheduler=scheduler, force=force)
+        outcome = run_study(study, workers=workers, executor=executor, scheduler=scheduler, force=force,
+                            storage=storage)
     except (StudyError, ValueError) as e:
         _fail(str(e))
     except StudyLocked as e:

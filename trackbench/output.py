@@ -172,18 +172,14 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     return xr.Dataset(v, coords=coords, attrs=attrs)
 
 
-def write_netcdf(ds, path, compress=False):
-    """Write atomically (trackbench/atomic.py). Uncompressed by default: zlib (level 4)
-    takes ~1x the solve time of paper_step for a 30 % smaller file."""
+def write_netcdf(ds, path, storage="full"):
+    """Write atomically (trackbench/atomic.py): ``storage`` "full" (lossless, zstd) or
+    "compact" (time histories at a stated resolution), see trackbench/storage.py."""
+    from .storage import check_storage, write
+    check_storage(storage)
     path = Path(path)
-    enc = {}
-    if compress:
-        enc = {k: {"zlib": True, "complevel": 4, "shuffle": True}
-               for k, var in ds.data_vars.items() if var.ndim >= 1}
-    for k in ds.coords:
-        enc[k] = {"_FillValue": None}
     with atomic_path(path) as tmp:
-        ds.to_netcdf(tmp, engine="netcdf4", encoding=enc)
+        write(ds, tmp, storage)
     return path
 
 

@@ -82,10 +82,15 @@ def format_summary(ds, path=None):
     return "\n".join(lines)
 
 
-def run_one(sets, duration, out, name, force=False):
-    """Run, write OUT/NAME.nc (+ NAME.rrd); a failed run is kept for diagnosis as
-    NAME.failed.nc, never under the name of a complete result. Existing files of that
-    name are only replaced with force. Returns (text, ok)."""
+def run_one(sets, duration, out, name, force=False, storage="full"):
+    """Run, write OUT/NAME.nc (+ NAME.rrd) as ``storage`` says (trackbench/storage.py); a
+    failed run is kept for diagnosis as NAME.failed.nc, never under the name of a complete
+    result. Existing files of that name are only replaced with force. Returns (text, ok)."""
+    from .storage import check_storage
+    try:
+        check_storage(storage)
+    except ValueError as e:
+        raise ScenarioError(str(e)) from None
     sc = scenario_from_sets(sets, duration)   # bad input fails here, before the solver libraries load
     sc = sc.with_overrides({"name": name})
     from .output import write_netcdf
@@ -97,12 +102,12 @@ def run_one(sets, duration, out, name, force=False):
         raise ScenarioError(f"{existing[0]} exists: choose another --name or --out, or --force to replace it")
     ds = simulate(sc)
     ok = ds.attrs["status"] == "completed"
-    path = write_netcdf(ds, targets[0] if ok else targets[2])
+    path = write_netcdf(ds, targets[0] if ok else targets[2], storage)
     for stale in existing:
         if stale != path:
             stale.unlink(missing_ok=True)
     if ok:
-        maybe_write_recording(ds, Path(out), name=f"{name}.rrd")
+        maybe_write_recording(ds, Path(out), name=f"{name}.rrd", storage=storage)
     return format_summary(ds, path), ok
 
 

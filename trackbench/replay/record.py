@@ -251,14 +251,16 @@ def _log_static(rec, ds):
     rec.log(E_SOLVER, rr.TextDocument(solver_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
 
 
-def _log_signals(rec, ds):
-    """Time series at every output frame (cheap; keeps the peaks). Multi-series entities
-    (wheel forces, energies) hold one scalar per series per row."""
-    t = [rr.TimeColumn(TIMELINE, duration=np.asarray(ds.variables["time"].values, dtype=np.float64))]
+def _log_signals(rec, ds, every=1):
+    """Time series at every output frame (keeps the peaks), or at every ``every``-th (and the
+    last: compact storage). Multi-series entities (wheel forces, energies) hold one scalar per
+    series per row."""
+    idx = None if every == 1 else frame_indices(ds.sizes["time"], every)
+    t = [rr.TimeColumn(TIMELINE, duration=np.asarray(_rows(ds.variables["time"].values, idx), dtype=np.float64))]
     d = rr.Scalars.descriptor_scalars()
 
     def scalars(a):
-        a = np.ascontiguousarray(a, dtype=np.float64)
+        a = np.ascontiguousarray(_rows(a, idx), dtype=np.float64)
         n, k = a.shape[0], (a.shape[1] if a.ndim == 2 else 1)
         return [_Column(d, _list(pa.array(a.reshape(-1), type=_SCALAR_TYPE), n, k))]
 
@@ -268,6 +270,10 @@ def _log_signals(rec, ds):
     e = np.stack([ds.variables[var].values for _, var, _ in ENERGY_SERIES], axis=1)
     rec.send_columns(E_ENERGY, indexes=t, columns=scalars(e))
     rec.send_columns(E_TENSION, indexes=t, columns=scalars(np.nanmax(ds.variables["link_tension"].values, axis=1)))
+
+
+def _rows(a, idx):
+    return a if idx is None else np.asarray(a)[idx]
 
 
 def _log_track(rec, t, take, n):
@@ -360,11 +366,11 @@ def _log_frames(rec, ds, idx):
                   _Column(rr.Arrows2D.descriptor_vectors(), _list(_vec2(g_vector), n, 1))])
 
 
-def write_recording(ds, path, every=1):
+def write_recording(ds, path, every=1, signal_every=1):
     """Write the run's rerun recording to `path` (atomically); returns the Path.
 
     every: log the side-view geometry at every `every`-th output frame (and the last);
-    the time series are always logged at every output frame."""
+    signal_every: the same for the time series (1, every frame, keeps their peaks)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     idx = frame_indices(ds.sizes["time"], int(every))
@@ -376,7 +382,7 @@ def write_recording(ds, path, every=1):
             rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
             # rerun encodes what was sent on its own thread while the next entity is prepared:
             # the time series first (nothing to prepare), then the geometry
-            _log_signals(rec, ds)
+            _log_signals(rec, ds, int(signal_every))
             _log_frames(rec, ds, idx)
             _log_static(rec, ds)
             rec.flush()
@@ -385,10 +391,12 @@ def write_recording(ds, path, every=1):
     return path
 
 
-def maybe_write_recording(ds, folder, name=RECORDING_NAME):
-    """Write folder/name when the scenario's record.enabled is true (with its record.every);
-    returns the Path, or None when recording is switched off."""
+def maybe_write_recording(ds, folder, name=RECORDING_NAME, storage="full"):
+    """Write folder/name when the scenario's record.enabled is true (with its record.every,
+    thinned for compact storage); returns the Path, or None when recording is switched off."""
     enabled, every = record_settings(ds)
     if not enabled:
         return None
-    return write_recording(ds, Path(folder) / name, every=every)
+    from ..storage import recording_steps
+    frames, signals = recording_steps(every, storage)
+    return write_recording(ds, Path(folder) / name, every=frames, signal_every=signals)

@@ -1,4 +1,8 @@
-"""Where runs execute: one worker function, a local process pool (spawn) or dask.distributed.
+"""Where runs execute: one worker function, a local process pool or dask.distributed.
+
+Worker processes are forks of a fork server that has loaded everything a run needs once
+(preload.py says what, and why forking it is safe); where there is no fork server, they
+are spawned and warm themselves up (_warm).
 
 Tasks and results are plain dicts (picklable, no Scenario objects)."""
 
@@ -6,6 +10,7 @@ import errno
 import os
 import shutil
 import socket
+import threading
 import time
 import traceback
 import uuid
@@ -15,6 +20,7 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
+from ..storage import recording_steps
 from . import store
 
 
@@ -28,8 +34,9 @@ def run_summary(ds):
     return Q.without_nan(Q.values(ds))
 
 
-def _record(ds, rdir, scenario):
-    """Write recording.rrd beside timeseries.nc when asked and possible; returns (name, error)."""
+def _record(ds, rdir, scenario, storage="full"):
+    """Write recording.rrd beside timeseries.nc when asked and possible (thinned for compact
+    storage); returns (name, error)."""
     if not scenario.get("record", {}).get("enabled"):
         return None, None
     try:
@@ -40,7 +47,8 @@ def _record(ds, rdir, scenario):
         target = Path(rdir) / "recording.rrd"
         tmp = store.tmp_path(target) + ".rrd"
         try:   # a writer of its own temporary: whatever happens inside, only a finished file lands
-            write_recording(ds, tmp, every=int(scenario["record"].get("every", 1)))
+            frames, signals = recording_steps(scenario["record"].get("every", 1), storage)
+            write_recording(ds, tmp, every=frames, signal_every=signals)
             os.replace(tmp, target)
         finally:
             for p in (tmp, tmp[:-4]):
@@ -55,7 +63,8 @@ def execute_run(task):
     """Run one study run in this process and write its folder; returns the run.json dict.
 
     task: run_id, output (absolute: the study folder as every worker sees it), scenario
-    (resolved dict), meta (study, variant, replicate, params), compress, attempt, attempt_id.
+    (resolved dict), meta (study, variant, replicate, params), storage ("full" or "compact"),
+    attempt, attempt_id.
     Never raises for a failing run: the failure is the record (its reason in status_message,
     the original exception in exception)."""
     t0 = time.perf_counter()
@@ -133,8 +142,9 @@ def _free_bytes(folder):
 
 def _fail(rec, exc, folder, need_bytes=None):
     """Mark ``rec`` failed by ``exc``: the readable reason, the original exception, the traceback."""
+    tb = "".join(traceback.format_exception(exc, limit=8))
     rec.update(status="failed", status_message=failure_reason(exc, folder, need_bytes),
-               exception=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc(limit=8))
+               exception=f"{type(exc).__name__}: {exc}", traceback=tb)
 
 
 def _simulate(task, rec):
@@ -152,19 +162,45 @@ def _simulate(task, rec):
         return None
 
 
+def _in_thread(fn, *args):
+    """Start fn(*args) in a thread; returns a function that waits for it and returns the
+    exception it raised, or None."""
+    box = {}
+
+    def body():
+        try:
+            fn(*args)
+        except BaseException as e:  # handed to the caller
+            box["exc"] = e
+    th = threading.Thread(target=body, name="trackbench-netcdf", daemon=True)
+    th.start()
+
+    def join():   # pop: no reference cycle keeps the exception's frames (and an open file) alive
+        th.join()
+        return box.pop("exc", None)
+    return join
+
+
 def _write(ds, rdir, task, rec):
-    """timeseries.nc (and the recording) of a finished simulation; the solver's verdict in ``rec``."""
-    try:
-        store.write_timeseries(ds, rdir / "timeseries.nc", compress=task.get("compress", False))
-    except Exception as e:
-        _fail(rec, e, rdir, need_bytes=ds.nbytes)
+    """timeseries.nc and the recording of a finished simulation, written at the same time
+    (netCDF's writes and compression and rerun's encoding run outside the GIL); the solver's
+    verdict in ``rec``. When timeseries.nc cannot be written the run fails and keeps no recording."""
+    storage = task.get("storage", "full")
+    written = _in_thread(store.write_timeseries, ds, rdir / "timeseries.nc", storage)
+    recording, err = _record(ds, rdir, task["scenario"], storage)
+    exc = written()
+    if exc is not None:
+        if recording:
+            (rdir / recording).unlink(missing_ok=True)
+        if not isinstance(exc, Exception):
+            raise exc
+        _fail(rec, exc, rdir, need_bytes=ds.nbytes)
         return
     a = ds.attrs
     msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-               timeseries="timeseries.nc", results=run_summary(ds))
-    rec["recording"], err = _record(ds, rdir, task["scenario"])
+               timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording)
     if err:
         rec["recording_error"] = err
 
@@ -203,7 +239,8 @@ def crashed(task, exc, tries=None):
 
 
 def _warm():
-    """Pool initializer: import the package, netCDF4 and xarray's backends once per worker,
+    """Pool initializer without a fork server (spawned workers): import the package, netCDF4
+    and xarray's backends once per worker,
     load the compiled kernels from the numba cache and set up netCDF and rerun (a 1 ms run
     written to a temporary folder: ~1 s the first time in a process, which would otherwise
     land on the worker's first run)."""
@@ -233,14 +270,45 @@ def _attempt(task, number):
     return {**task, "attempt": number, "attempt_id": uuid.uuid4().hex}
 
 
-def _new_pool(workers):
+PRELOAD = "trackbench.study.preload"
+
+
+def _context():
+    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
+    where the platform has no fork server."""
     import multiprocessing
-    ctx = multiprocessing.get_context("spawn")
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload([PRELOAD])
+    return ctx
+
+
+def start_workers(executor="local", scheduler=None):
+    """Start the fork server now (it loads in its own process while the command does its own
+    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler."""
     # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
-    # threads spin (seen at ~6 % of a core per worker); spawned children inherit this
+    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
+    # pyarrow: the fork server and the workers inherit this, and so the server has a single
+    # thread when it forks (preload.py)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_warm)
+    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
+    if scheduler:
+        return
+    ctx = _context()
+    if ctx.get_start_method() == "forkserver":
+        if executor == "dask":   # its nannies start worker processes from the same server
+            ctx.set_forkserver_preload(["distributed", PRELOAD])
+        from multiprocessing import forkserver
+        forkserver.ensure_running()
+
+
+def _new_pool(workers):
+    start_workers()
+    ctx = _context()
+    warm = _warm if ctx.get_start_method() == "spawn" else None
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=warm)
 
 
 def _next_task(fresh, retry, running):
@@ -251,18 +319,21 @@ def _next_task(fresh, retry, running):
     return fresh.popleft() if fresh else None
 
 
-def run_local(tasks, workers=2, notify=None):
-    """Yield (task, record) as runs finish, on a spawn-context process pool.
+def run_local(tasks, workers=2, notify=None, on_running=None):
+    """Yield (task, record) as runs finish, on a process pool (forks of the fork server).
 
     No more runs are submitted than there are workers, so the runs in flight are known: a
     worker that dies (killed, out of memory) breaks the pool (BrokenProcessPool); the pool is
     started again and the runs that were in flight are tried again, each at most MAX_ATTEMPTS
-    times, and yielded once. ``notify(text)`` hears about the restarts."""
+    times, and yielded once. ``notify(text)`` hears about the restarts, ``on_running(n)`` how
+    many runs are in flight."""
     fresh, retry, running, pool = deque(_attempt(t, 1) for t in tasks), deque(), {}, None
     try:
         while fresh or retry or running:
             pool = pool or _new_pool(workers)
             broken = _fill(pool, fresh, retry, running, workers)
+            if on_running:
+                on_running(len(running))
             if not broken:
                 wait(list(running), return_when=FIRST_COMPLETED)
                 broken = any(f.done() and not f.cancelled() and isinstance(f.exception(), BrokenProcessPool)
@@ -317,7 +388,9 @@ def run_dask(tasks, workers=2, scheduler=None, notify=None):
         except (OSError, TimeoutError) as e:
             raise RuntimeError(f"cannot reach the dask scheduler at {scheduler}: {e}") from None
     else:
-        with dask.config.set({"distributed.scheduler.allowed-failures": MAX_ATTEMPTS - 1}):
+        start_workers("dask")
+        with dask.config.set({"distributed.scheduler.allowed-failures": MAX_ATTEMPTS - 1,
+                              "distributed.worker.multiprocessing-method": _context().get_start_method()}):
             cluster = LocalCluster(n_workers=workers, processes=True, threads_per_worker=1,
                                    dashboard_address=None)
         client = Client(cluster)
@@ -336,6 +409,16 @@ def run_dask(tasks, workers=2, scheduler=None, notify=None):
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def check_arguments(workers, executor, scheduler, storage):
+    """Raise ValueError (one line) on a bad worker count, executor or storage; nothing is started."""
+    if not isinstance(workers, int) or isinstance(workers, bool) or workers < 1:
+        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
+    check_executor(executor, scheduler)
+    if storage is not None:
+        from ..storage import check_storage
+        check_storage(storage)
 
 
 def check_executor(executor, scheduler):

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import executors, store
-from .spec import load_study, resolved_toml
+from .spec import Study, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
 
@@ -58,31 +58,33 @@ def manifest(study):
     """runs.json: the study's runs as expanded now, so the folder can be read later even when
     the package's defaults (and so a re-expansion's run ids) have changed."""
     return {"name": study.name, "description": study.description, "replicates": study.replicates,
-            "param_names": study.param_names,
+            "storage": study.storage, "param_names": study.param_names,
             "runs": [{"run_id": r.run_id, "index": r.index, "variant": r.variant, "replicate": r.replicate,
                       "params": r.params, "scenario": r.scenario} for r in study.runs]}
 
 
 def plan(study, force=False):
-    """(tasks to run, ids already completed)."""
+    """(tasks to run, ids already completed); each task stores its files as study.storage says."""
     tasks, done = [], []
     for run in study.runs:
         if not force and store.is_completed(study.output, run.run_id):
             done.append(run.run_id)
             continue
         tasks.append({"run_id": run.run_id, "output": str(study.output), "scenario": run.scenario,
+                      "storage": study.storage,
                       "meta": {"study": study.name, "index": run.index, "variant": run.variant,
                                "replicate": run.replicate, "params": run.params}})
     return tasks, done
 
 
 class _Progress:
-    """A rich progress bar on a terminal; one plain line per finished run otherwise."""
+    """A live rich progress bar on a terminal (done, failed, running, elapsed, ETA); one plain
+    line per finished run otherwise (a log, a pipe, CI)."""
 
-    def __init__(self, total, skipped, quiet=False, stream=None):
+    def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None):
         from rich.console import Console
-        self.console = Console(file=stream or sys.stderr)
-        self.total, self.done, self.failed = total, 0, 0
+        self.console = Console(file=stream or sys.stderr, force_terminal=terminal)
+        self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
         self.quiet, self.t0 = quiet, time.perf_counter()
         self.bar = None
         if not quiet and self.console.is_terminal and total:
@@ -95,8 +97,18 @@ class _Progress:
         elif not quiet:
             self.console.print(f"{total} runs to do, {skipped} already completed", highlight=False)
 
+    def _running(self):
+        left = self.total - self.done - self.failed
+        return min(left, self.workers if self.in_flight is None else self.in_flight)
+
     def _counts(self):
-        return f"done {self.done}  failed {self.failed}  remaining {self.total - self.done - self.failed}"
+        return f"done {self.done}  failed {self.failed}  running {self._running()}  of {self.total}"
+
+    def running(self, n):
+        """The executor's count of runs in flight (without it: one per worker)."""
+        self.in_flight = n
+        if self.bar is not None:
+            self.bar.update(self.task, counts=self._counts())
 
     def update(self, rec):
         if rec["status"] == "completed":
@@ -123,30 +135,26 @@ class _Progress:
 
 
 def run_study(path, workers=2, executor="local", scheduler=None, force=False, output=None,
-              quiet=False, compress=False):
-    """Run a study file; raises StudyError / ValueError before anything starts on bad input,
-    StudyLocked when another process works on the same folder."""
-    if not isinstance(workers, int) or workers < 1:
-        raise ValueError(f"--workers {workers!r} is not allowed: expected an integer >= 1")
-    executors.check_executor(executor, scheduler)
-    study = load_study(path, output=output)
-    # workers get absolute paths only: a relative one would land in each worker's own cwd
-    study.output = Path(os.path.abspath(study.output))
-    out = Outcome(study=study)
+              quiet=False, storage=None):
+    """Run a study (a study file, or a Study that load_study returned); raises StudyError /
+    ValueError before anything starts on bad input, StudyLocked when another process works on
+    the same folder. ``storage`` ("full" or "compact") overrides the study's [study] storage."""
     t0 = time.perf_counter()
+    study = _prepare(path, workers, executor, scheduler, output, storage)
+    out = Outcome(study=study)
     with store.study_lock(study.output):
         store.clean_tmp(study.output)
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
-        for t in tasks:
-            t["compress"] = compress
+        if tasks:
+            executors.start_workers(executor, scheduler)   # they load while this process sets up
         out.skipped = len(done)
-        progress = _Progress(len(tasks), len(done), quiet)
+        progress = _Progress(len(tasks), len(done), quiet, workers=workers)
         if executor == "dask":
             stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
         else:
-            stream = executors.run_local(tasks, workers, notify=progress.note)
+            stream = executors.run_local(tasks, workers, notify=progress.note, on_running=progress.running)
         try:
             if tasks:
                 for task, rec in stream:
@@ -162,6 +170,17 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
             _summarise(study, out)
     out.elapsed = time.perf_counter() - t0
     return out
+
+
+def _prepare(path, workers, executor, scheduler, output, storage):
+    """The study to run, its folder absolute, its storage decided; raises on bad input."""
+    executors.check_arguments(workers, executor, scheduler, storage)
+    study = path if isinstance(path, Study) and output is None else load_study(getattr(path, "source", path),
+                                                                               output=output)
+    # workers get absolute paths only: a relative one would land in each worker's own cwd
+    study.output = Path(os.path.abspath(study.output))
+    study.storage = storage or study.storage
+    return study
 
 
 def _summarise(study, out):

@@ -1,6 +1,6 @@
 """Study files (TOML): parse, validate and expand into runs before anything starts.
 
-    [study]     name, description, output, replicates
+    [study]     name, description, output, replicates, storage ("full" or "compact")
     [scenario]  the base scenario (anything left out takes the paper's value)
     [grid]      cartesian axes: name = [values] | {start, stop, step} | {start, stop, num}
     [[zip]]     axes varied together (equal lengths), crossed with [grid]
@@ -22,7 +22,7 @@ from ..scenario import Scenario, ScenarioError, parameter_names
 from .runid import run_id
 
 TOP_KEYS = ("study", "scenario", "grid", "zip", "runs")
-STUDY_KEYS = ("name", "description", "output", "replicates")
+STUDY_KEYS = ("name", "description", "output", "replicates", "storage")
 RANGE_KEYS = ("start", "stop", "step", "num")
 REPLICATE_PERTURBATION = 1e-9  # m
 MAX_RUNS = 100_000
@@ -56,6 +56,7 @@ class Study:
     explicit: list = field(default_factory=list)   # the [[runs]] tables
     runs: list = field(default_factory=list)
     param_names: list = field(default_factory=list)
+    storage: str = "full"  # how the runs' files are stored (trackbench/storage.py)
 
     @property
     def runs_dir(self):
@@ -266,7 +267,7 @@ def load_study(path, output=None):
     if len(variants) * reps > MAX_RUNS:
         raise StudyError(f"{path}: the study has {len(variants) * reps} runs; at most {MAX_RUNS}")
     study = Study(name=name, description=desc, source=path, output=Path(output or out), replicates=reps,
-                  base=base.to_dict(), axes=axes, zips=zips, explicit=explicit)
+                  base=base.to_dict(), axes=axes, zips=zips, explicit=explicit, storage=_storage(path, meta))
     names = []
     for v in variants:
         names += [n for n in v if n not in names]
@@ -299,6 +300,14 @@ def load_study(path, output=None):
     return study
 
 
+def _storage(path, meta):
+    from ..storage import check_storage
+    try:
+        return check_storage(meta.get("storage", "full"), f"{path}: [study] storage =")
+    except ValueError as e:
+        raise StudyError(str(e)) from None
+
+
 def _toml_value(v):
     if isinstance(v, bool):
         return "true" if v else "false"
@@ -327,7 +336,7 @@ def resolved_toml(study):
     """The resolved copy of the study: full base scenario, ranges expanded."""
     lines = [f"# resolved copy of {study.source}: {len(study.runs)} runs", "",
              "[study]", f"name = {_toml_value(study.name)}", f"description = {_toml_value(study.description)}",
-             f"replicates = {study.replicates}", "", "[scenario]"]
+             f"replicates = {study.replicates}", f"storage = {_toml_value(study.storage)}", "", "[scenario]"]
     tables = []
     for k, v in study.base.items():
         if k == "name":

@@ -45,10 +45,10 @@ def _json_default(x):
     return str(x)
 
 
-def write_timeseries(ds, path, compress=False):
-    """netCDF, atomically (output.write_netcdf)."""
+def write_timeseries(ds, path, storage="full"):
+    """netCDF, atomically (output.write_netcdf), as ``storage`` says (trackbench/storage.py)."""
     from ..output import write_netcdf
-    return write_netcdf(ds, path, compress=compress)
+    return write_netcdf(ds, path, storage)
 
 
 def write_table(df, stem):

@@ -1,0 +1,76 @@
+"""What the study workers' fork server loads once, before it forks any worker.
+
+`study run` starts a fork server (multiprocessing's "forkserver": a fresh Python process
+started from the command, not a fork of it) with this module as its preload. Importing it
+imports the package, numpy, numba, xarray, pandas and netCDF4, loads the compiled kernels
+from the numba cache by running a 1 ms simulation, and writes one small netCDF file (HDF5's
+set-up and the zstd filter plugin) in a temporary folder. Each worker is then a fork of this
+process: it starts with all of that done instead of redoing it. Should the command be gone
+before the preload ends (Ctrl-C), the server stops instead of loading for nobody.
+
+Why forking it is safe: the fork server has a single thread from start to fork, and a
+fork of a single-threaded process cannot inherit a lock held by another thread. numba's
+compiled code here uses no threading layer (no parallel=True), so it starts no thread; no
+file is left open. Three libraries would start threads, so the command sets, before the
+server starts: OPENBLAS_NUM_THREADS=1 (no BLAS thread pool) and
+JE_ARROW_MALLOC_CONF=background_thread:false (pyarrow, which pandas imports, would start
+jemalloc's background thread); and rerun is not imported here: its import starts a tokio
+runtime with worker threads, so each worker imports it at its first recording. THREADS_AT_FORK
+records the thread count at the end of the preload (1; a test checks it through a worker).
+The command itself, which may run threads (the progress display, dask's scheduler), is
+never forked.
+"""
+
+import os
+
+THREADS_AT_FORK = None
+PARENT = os.getppid()   # the command that started the server
+
+
+def _orphaned():
+    """The command is gone (Ctrl-C, a resumed study with nothing to run): the preload stops,
+    instead of loading for nobody."""
+    if os.getppid() != PARENT:
+        os._exit(0)
+
+
+def _threads():
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return None
+
+
+def warm():
+    """Load everything a run needs; errors are left for the real runs to report."""
+    import tempfile
+    from pathlib import Path
+
+    import netCDF4  # noqa: F401
+    import pandas  # noqa: F401  (the summary of a run's results)
+    import xarray  # noqa: F401
+
+    import trackbench
+    from trackbench.output import write_netcdf
+    from trackbench.study import executors
+
+    _orphaned()
+    ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
+    _orphaned()
+    executors.run_summary(ds)
+    with tempfile.TemporaryDirectory() as tmp:
+        write_netcdf(ds, Path(tmp) / "warm.nc")
+
+
+def facts():
+    """What a worker inherited (for tests and diagnosis): its pid, the fork server's thread
+    count at the end of the preload, and how many compiled signatures the time loop has."""
+    from trackbench.solvers.reduced import integrate
+    return {"pid": os.getpid(), "threads_at_fork": THREADS_AT_FORK, "loop_signatures": len(integrate.signatures)}
+
+
+try:
+    warm()
+except Exception:  # noqa: BLE001  (warming is an optimisation only)
+    pass
+THREADS_AT_FORK = _threads()
