@@ -50,6 +50,8 @@ def test_speed_sweep_cli_end_to_end(sweep):
     out = d / "results" / "speed_sweep"
     assert "15 runs, 15 run now, 0 already completed, 0 failed" in first.stdout
     assert "[15/15]" in first.stderr and "ETA" in first.stderr
+    progress = [line for line in first.stderr.splitlines() if "ETA" in line]   # one line a run, never wrapped
+    assert len(progress) == 15 and all(line.startswith("[") and line.endswith(" s)") for line in progress)
     df = pd.read_csv(out / "summary.csv")
     assert len(df) == 15 and set(df.status) == {"completed"}
     pq = pd.read_parquet(out / "summary.parquet")
@@ -276,7 +278,8 @@ def _write(tmp_path, text):
 def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     import io
     from trackbench.study.runner import _Progress
-    runs = [{"run_id": "a1", "status": "completed"}, {"run_id": "b2", "status": "failed", "status_message": "NaN"},
+    runs = [{"run_id": "a1", "status": "completed"}, {"run_id": "b2", "status": "failed",
+                                                      "status_message": "NaN " + "x" * 200},
             {"run_id": "c3", "status": "completed"}]
     log = io.StringIO()
     p = _Progress(3, 1, stream=log, workers=2)
@@ -285,7 +288,7 @@ def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     p.close()
     lines = log.getvalue().splitlines()
     assert lines[0] == "3 runs to do, 1 already completed" and len(lines) == 4 and "\x1b" not in log.getvalue()
-    assert lines[2].startswith("[2/3] b2 failed: NaN  (done 1  failed 1  running 1  of 3, ETA")
+    assert lines[2].startswith("[2/3] b2 failed: NaN xxx") and lines[2].endswith("(done 1  failed 1  running 1  of 3, ETA 0 s)")
     term = io.StringIO()
     p = _Progress(3, 0, stream=term, workers=2, terminal=True)
     p.running(2)

@@ -84,6 +84,7 @@ class _Progress:
     def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None):
         from rich.console import Console
         self.console = Console(file=stream or sys.stderr, force_terminal=terminal)
+        self.console.soft_wrap = not self.console.is_terminal   # a log keeps one line per run, however long
         self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
         self.quiet, self.t0 = quiet, time.perf_counter()
         self.bar = None
