@@ -221,7 +221,7 @@ def plot_run(ds_or_path, out_dir, times=DEFAULT_TIMES):
         dissipated = ds["energy_dissipated"].values
         e0 = float(ds.attrs["initial_total_energy"])
         e.append(((ds["energy_balance"].values + dissipated) / 1e3, "balance + dissipated", {"color": "C4", "lw": 1.0}))
-        e.append((dissipated / 1e3, "dissipated by dampers", {"color": "C5", "lw": 1.0}))
+        e.append((dissipated / 1e3, "dissipated (dampers, friction)", {"color": "C5", "lw": 1.0}))
         deviation.append((100 * (ds["energy_balance_error"].values + (dissipated - dissipated[0]) / e0),
                           "balance + dissipated", {"color": "C4", "lw": 0.9}))
     paths.append(_time_plot(out / "energy.png", f"{name}: energies (cf. Fig. 18)",
