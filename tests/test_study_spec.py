@@ -83,10 +83,10 @@ def test_no_grid_is_one_run_of_the_base_scenario():
     assert s.runs[0].scenario["terrain"]["height"] == 0.1
 
 
-@pytest.mark.parametrize("name", ["obstacle_height", "track_tension"])
+@pytest.mark.parametrize("name", sorted(p.stem for p in (REPO / "studies").glob("*.toml")))
 def test_shipped_studies_validate(name):
-    s = load_study(REPO / "studies" / f"{name}.toml")
-    assert len(s.runs) > 3
+    s = load_study(REPO / "studies" / f"{name}.toml")   # every run's scenario validated
+    assert len(s.runs) >= 2 and s.description
 
 
 BAD = [
