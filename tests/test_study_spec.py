@@ -86,7 +86,7 @@ def test_no_grid_is_one_run_of_the_base_scenario():
 @pytest.mark.parametrize("name", sorted(p.stem for p in (REPO / "studies").glob("*.toml")))
 def test_shipped_studies_validate(name):
     s = load_study(REPO / "studies" / f"{name}.toml")   # every run's scenario validated
-    assert len(s.runs) >= 2 and s.description
+    assert len(s.runs) >= 1 and s.description
 
 
 BAD = [
