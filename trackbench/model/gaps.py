@@ -119,6 +119,13 @@ def segment_coords(px, py, seg, j):
 
 
 @njit(**INLINE)
+def _under(s, dx, seg, j):
+    """Is a point at (s, dx) of segment_coords under the non-vertical segment j, within its
+    x-range (so inside the ground)?"""
+    return s < 0.0 and seg[j, SEG_TX] > 0.0 and 0.0 <= dx <= seg[j, SEG_LENGTH] * seg[j, SEG_TX]
+
+
+@njit(**INLINE)
 def pin_ground_selection(px, py, seg, nbr, row, hg):
     """Which of a pin's candidate segments may push it (model.md): (inside, n_below, best).
     inside: the pin is below a non-vertical segment within its x-range, i.e. inside the
@@ -133,8 +140,7 @@ def pin_ground_selection(px, py, seg, nbr, row, hg):
     for j in range(nbr[row, NB_COUNT]):
         sj = nbr[row, 1 + j]
         lam, s, dx = segment_coords(px, py, seg, sj)
-        if s < 0.0 and seg[sj, SEG_TX] > 0.0 and 0.0 <= dx <= seg[sj, SEG_LENGTH] * seg[sj, SEG_TX]:
-            inside = True
+        inside |= _under(s, dx, seg, sj)
         if lam < 0.0 or lam > seg[sj, SEG_LENGTH] or s >= hg:
             continue
         if s < 0.0:
@@ -176,8 +182,7 @@ def ground_distance(px, py, seg, nbr, row):
         sj = nbr[row, 1 + j]
         lam, s, dx = segment_coords(px, py, seg, sj)
         length = seg[sj, SEG_LENGTH]
-        if s < 0.0 and seg[sj, SEG_TX] > 0.0 and 0.0 <= dx <= length * seg[sj, SEG_TX]:
-            inside = True
+        inside |= _under(s, dx, seg, sj)
         lam = min(max(lam, 0.0), length)
         qx = px - seg[sj, SEG_X0] - lam * seg[sj, SEG_TX]    # P minus its nearest point on sj
         qy = py - seg[sj, SEG_Y0] - lam * seg[sj, SEG_TY]

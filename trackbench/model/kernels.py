@@ -208,6 +208,16 @@ def law_force(law, delta, rate, mem, row, partner):
 
 
 @njit(**INLINE)
+def _pad(plain, law, delta, rate, mem, row, partner):
+    """(force, energy, damping power) of a pad compressed by delta > 0: the paper's spring
+    inline (plain), any other law through law_force."""
+    if plain:
+        k = law[2]
+        return k * delta, 0.5 * k * delta ** 2, 0.0
+    return law_force(law, delta, rate, mem, row, partner)
+
+
+@njit(**INLINE)
 def _slip(mu, v_eps, p, v, t, fx, fy):
     """The force (fx, fy) on a track point plus its friction, the point sliding at v relative
     to what it presses on, along the contact's unit tangent t, under normal force p; and
@@ -267,7 +277,6 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
     row_link, row_pin = rows
     apos, avel, lk, fpin = w.apos, w.avel, w.lk, w.fpin
     ftx, fty, normal, energy, power, obstacle, dissipation = acc
-    k = law[2]
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped    # the paper's spring: no call
     for j in range(nbr[row_link, NB_COUNT]):
@@ -279,11 +288,8 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
         if s < 0.0:
             diag[D_STATUS] = status
             continue
-        if plain:
-            p, e, pd = k * (reach - s), 0.5 * k * (reach - s) ** 2, 0.0  # Eqs. (4), (6)
-        else:
-            rate = -side * _link_rate(vx, vy, avel, lk, b, d0) if damped else 0.0
-            p, e, pd = law_force(law, reach - s, rate, mem, row_link, b)
+        rate = -side * _link_rate(vx, vy, avel, lk, b, d0) if damped else 0.0
+        p, e, pd = _pad(plain, law, reach - s, rate, mem, row_link, b)     # Eqs. (4), (6)
         fx = p * lk[b, LK_TY]     # p n_inner: a corner lifts the link
         fy = -p * lk[b, LK_TX]
         if side > 0.0:            # a wheel presses it down
@@ -311,11 +317,8 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
         dist = math.sqrt(dx * dx + dy * dy)
         if dist >= reach:
             continue
-        if plain:
-            p, e, pd = k * (reach - dist), 0.5 * k * (reach - dist) ** 2, 0.0
-        else:
-            rate = -(dx * (vx - avel[b, 0]) + dy * (vy - avel[b, 1])) / dist if damped else 0.0
-            p, e, pd = law_force(law, reach - dist, rate, mem, row_pin, b)
+        rate = -(dx * (vx - avel[b, 0]) + dy * (vy - avel[b, 1])) / dist if damped else 0.0
+        p, e, pd = _pad(plain, law, reach - dist, rate, mem, row_pin, b)
         if weight != 1:
             p, e, pd = weight * p, weight * e, weight * pd
         acc = (ftx, fty, normal, energy, power, obstacle, dissipation)
@@ -361,7 +364,6 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
     the order of one loop. Every segment after the first (the ground the vehicle starts
     on) belongs to an obstacle."""
     law = contact_law(par, P_C_GROUND)
-    k = law[2]
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
@@ -393,11 +395,8 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
                     continue
             if s >= hg:
                 continue
-            if plain:
-                p, e, pd = k * (hg - s), 0.5 * k * (hg - s) ** 2, 0.0  # Eq. (6)
-            else:
-                rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
-                p, e, pd = law_force(law, hg - s, rate, mem, row, partner)
+            rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
+            p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
             acc = _push_pin(fpin, avel, b, (p * nx, p * ny, p, e, pd), (0.0, 0.0), (ny, -nx), (mu, v_eps), acc,
                             (0.0, p if sj > 0 else 0.0))

@@ -239,24 +239,12 @@ def crashed(task, exc, tries=None):
 
 
 def _warm():
-    """Pool initializer without a fork server (spawned workers): import the package, netCDF4
-    and xarray's backends once per worker,
-    load the compiled kernels from the numba cache and set up netCDF and rerun (a 1 ms run
-    written to a temporary folder: ~1 s the first time in a process, which would otherwise
-    land on the worker's first run)."""
-    import netCDF4  # noqa: F401
-    import xarray
-
-    import tempfile
-
-    import trackbench
-    xarray.backends.list_engines()
-    try:  # warming is an optimisation only; a real run reports real errors
-        ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
-        with tempfile.TemporaryDirectory() as tmp:
-            store.write_timeseries(ds, Path(tmp) / "warm.nc")
-            from ..replay.record import write_recording
-            write_recording(ds, Path(tmp) / "warm.rrd")
+    """Pool initializer of spawned workers (no fork server): the fork server's preload, run
+    in the worker itself (importing preload.py warms the process), and rerun's set-up, which
+    the fork server leaves out. Warming is an optimisation only: a real run reports errors."""
+    try:
+        from . import preload
+        preload.warm_recording()
     except Exception:
         pass
 

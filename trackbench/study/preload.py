@@ -62,6 +62,20 @@ def warm():
         write_netcdf(ds, Path(tmp) / "warm.nc")
 
 
+def warm_recording():
+    """rerun's set-up (a tiny recording in a temporary folder), for spawned workers only: its
+    import starts threads, which a fork server must not have."""
+    import tempfile
+    from pathlib import Path
+
+    import trackbench
+    from trackbench.replay.record import write_recording
+
+    ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
+    with tempfile.TemporaryDirectory() as tmp:
+        write_recording(ds, Path(tmp) / "warm.rrd")
+
+
 def facts():
     """What a worker inherited (for tests and diagnosis): its pid, the fork server's thread
     count at the end of the preload, and how many compiled signatures the time loop has."""
