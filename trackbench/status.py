@@ -11,6 +11,8 @@ class Result(IntEnum):
     CORNER_THROUGH_TRACK = 4
     MAX_STEPS = 5
     CONSTRAINT_ITERATION = 6
+    PIN_THROUGH_SPROCKET = 7
+    IDLER_OFF_GUIDE = 8
 
     @property
     def message(self) -> str:
@@ -25,6 +27,8 @@ _MESSAGES = {
     Result.CORNER_THROUGH_TRACK: "a ground corner went through the track (corner crossed a link's centre line)",
     Result.MAX_STEPS: "the maximum number of steps was reached",
     Result.CONSTRAINT_ITERATION: "the Lagrange-multiplier iteration did not converge",
+    Result.PIN_THROUGH_SPROCKET: "a track pin went into a sprocket tooth (it jumped the teeth)",
+    Result.IDLER_OFF_GUIDE: "the idler ran off the end of its guide (idler.travel)",
 }
 
 # plain ints for use inside numba kernels
@@ -35,3 +39,5 @@ WHEEL_THROUGH_TRACK = int(Result.WHEEL_THROUGH_TRACK)
 CORNER_THROUGH_TRACK = int(Result.CORNER_THROUGH_TRACK)
 MAX_STEPS = int(Result.MAX_STEPS)
 CONSTRAINT_ITERATION = int(Result.CONSTRAINT_ITERATION)
+PIN_THROUGH_SPROCKET = int(Result.PIN_THROUGH_SPROCKET)
+IDLER_OFF_GUIDE = int(Result.IDLER_OFF_GUIDE)

@@ -23,6 +23,9 @@ ModelArrays = namedtuple("ModelArrays", [
     "counters",   # int (N_COUNTERS,) C_*
     "v0",         # (rows, width - 1) approach speed of each pair at its onset, nbr's row layout
                   # and the partner (link, pin or segment) as column; 0 = not in contact
+    "pins",       # int (N_PN,) which pin rows are free, PN_*
+    "loop",       # (N_LOOP,) sprocket, tensioner and drive of the closed layout, LP_*; empty for the paper's
+    "guides",     # (n_guides, N_G_COLS) idler (row 0) and support rollers, G_*; no rows for the paper's
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -54,25 +57,56 @@ def arm_table(pivots, phi0, damping):
     return arms
 
 
-def model_arrays(par, arms, ends, seg, corners, n_links):
-    """The bundle, with empty candidate lists (marked stale: built at the first use)."""
+def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None):
+    """The bundle, with empty candidate lists (marked stale: built at the first use).
+    loop and guides: the closed layout's (LP_*, G_*); None for the paper's."""
     n_wheels = arms.shape[0]
-    rows = L.neighbour_rows(n_wheels, corners.shape[0], n_links)
+    closed = loop is not None
+    guides = np.zeros((0, L.N_G_COLS)) if guides is None else guides
+    rows = L.neighbour_rows(n_wheels, corners.shape[0], n_links, guides.shape[0])
     nbr = np.zeros((rows[L.N_KINDS], L.neighbour_width(n_links, seg.shape[0])), dtype=np.int64)
-    ref = np.full((n_links + 1 + n_wheels, 2), np.nan)
+    ref = np.full((n_links + 1 + n_wheels + guides.shape[0], 2), np.nan)
+    pins = np.zeros(L.N_PN, dtype=np.int64)
+    pins[L.PN_LAST] = n_links if closed else n_links - 1
+    pins[L.PN_CLOSED] = int(closed)
     return ModelArrays(np.ascontiguousarray(par, dtype=float), np.ascontiguousarray(arms, dtype=float),
                        np.ascontiguousarray(ends, dtype=float), np.ascontiguousarray(seg, dtype=float),
                        np.ascontiguousarray(corners, dtype=float).reshape(-1, 2), nbr,
                        np.array(rows, dtype=np.int64), ref, np.zeros(L.N_COUNTERS, dtype=np.int64),
-                       np.zeros((nbr.shape[0], nbr.shape[1] - 1)))
+                       np.zeros((nbr.shape[0], nbr.shape[1] - 1)), pins,
+                       np.ascontiguousarray(loop if closed else np.zeros(0), dtype=float),
+                       np.ascontiguousarray(guides, dtype=float).reshape(-1, L.N_G_COLS))
 
 
 def work_arrays(m, n_wheels, n_links):
+    """Work for the paper's layout, LoopWork for the closed one (m.pins says which)."""
     n_pins = n_links + 1
-    return Work(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
-                np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
-                np.zeros((n_links, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
-                np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape))
+    closed = bool(m.pins[L.PN_CLOSED])
+    base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
+            np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
+            np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
+            np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape))
+    if not closed:
+        return Work(*base)
+    ng = m.guides.shape[0]
+    nq = L.n_coordinates(n_wheels, n_links, closed=True)
+    return LoopWork(*base, np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros(L.N_SP),
+                    np.zeros((2, ARM_COLS + 1)), np.zeros(nq))
+
+
+# The closed layout's scratch: Work, then the idler and rollers as Work has the road wheels,
+# the sprocket and the generalised forces (the static equilibrium solves for them).
+LoopWork = namedtuple("LoopWork", list(Work._fields) + [
+    "gc",         # (n_guides, 2) idler and roller centres
+    "gv",         # (n_guides, 2) their velocities
+    "fguide",     # (n_guides, 2) out: contact force of the track on each
+    "spr",        # (N_SP,) sprocket kinematics in, loads out (SP_*)
+    "extra",      # (2, ARM_COLS + 1) the sprocket's and the idler's rows of the mass matrix, as
+                  # Work.arm's, with their own diagonal mass in column ARM_COLS
+    "genf",       # (nq,) out: generalised forces at rest (no inertia terms) for the equilibrium
+])
+LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of LoopWork.extra
+ARM_D = ARM_COLS                   # column of LoopWork.extra: the diagonal mass
 
 
 # Scratch of the event location (solvers/events.py): the configuration at both ends of

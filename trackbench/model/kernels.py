@@ -22,6 +22,7 @@ from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
     LK_LENGTH, LK_TX, LK_TY,
+    G_REACH, K_GUIDE_LINK, K_GUIDE_PIN, PN_LAST,
     C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_FRICTION, P_FRICTION_VELOCITY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 
@@ -53,10 +54,10 @@ def _near_links(px, py, apos, reach, nbr, row):
 
 
 @njit(**INLINE)
-def _near_pins(px, py, apos, reach, nbr, row):
-    """Candidate row: every free pin within reach of P."""
+def _near_pins(px, py, apos, last, reach, nbr, row):
+    """Candidate row: every free pin (rows 1..last) within reach of P."""
     n = 0
-    for b in range(1, apos.shape[0] - 1):
+    for b in range(1, last + 1):
         dx = apos[b, 0] - px
         dy = apos[b, 1] - py
         if dx * dx + dy * dy < reach * reach:
@@ -66,20 +67,26 @@ def _near_pins(px, py, apos, reach, nbr, row):
 
 
 @njit(**BORROW)
-def build_neighbours(apos, wc, par, seg, corners, nbr, rows):
-    """Fill the candidate lists: every pair that could touch while no pin or wheel
-    moves more than half the skin from where it is now (rows: ModelArrays.nbr_rows)."""
+def build_neighbours(apos, wc, gc, m):
+    """Fill the candidate lists: every pair that could touch while no pin, wheel, idler or
+    roller (gc) moves more than half the skin from where it is now."""
+    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
+    last = m.pins[PN_LAST]
     skin = par[P_SKIN]
     hg = par[P_PAD_GROUND]
     reach_w = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL] + skin
     reach_cl = max(hg, par[P_PAD_WHEEL]) + skin
     for i in range(wc.shape[0]):
         _near_links(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_LINK] + i)
-        _near_pins(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_PIN] + i)
+        _near_pins(wc[i, 0], wc[i, 1], apos, last, reach_w, nbr, rows[K_WHEEL_PIN] + i)
+    for j in range(gc.shape[0]):
+        reach_g = m.guides[j, G_REACH] + skin
+        _near_links(gc[j, 0], gc[j, 1], apos, reach_g, nbr, rows[K_GUIDE_LINK] + j)
+        _near_pins(gc[j, 0], gc[j, 1], apos, last, reach_g, nbr, rows[K_GUIDE_PIN] + j)
     for c in range(corners.shape[0]):
         _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
-        _near_pins(corners[c, 0], corners[c, 1], apos, hg + skin, nbr, rows[K_CORNER_PIN] + c)
-    for b in range(1, apos.shape[0] - 1):
+        _near_pins(corners[c, 0], corners[c, 1], apos, last, hg + skin, nbr, rows[K_CORNER_PIN] + c)
+    for b in range(1, last + 1):
         row = rows[K_PIN_GROUND] + b
         n = 0
         for j in range(seg.shape[0]):
@@ -91,10 +98,12 @@ def build_neighbours(apos, wc, par, seg, corners, nbr, rows):
 
 
 @njit(**INLINE)
-def refresh_neighbours(apos, wc, par, seg, corners, nbr, rows, ref, counters):
-    """Rebuild the lists if any pin or wheel moved more than skin/2 since the last build
-    (so the lists always hold every pair that can touch: results equal a full search)."""
-    half = 0.5 * par[P_SKIN]
+def refresh_neighbours(apos, wc, gc, m):
+    """Rebuild the lists if any pin, wheel, idler or roller moved more than skin/2 since the
+    last build (so the lists always hold every pair that can touch: results equal a full
+    search). gc: the idler and roller centres (no rows in the paper's layout)."""
+    ref = m.ref
+    half = 0.5 * m.par[P_SKIN]
     lim = half * half
     n_pins = apos.shape[0]
     stale = False
@@ -106,15 +115,23 @@ def refresh_neighbours(apos, wc, par, seg, corners, nbr, rows, ref, counters):
         dx = wc[i, 0] - ref[n_pins + i, 0]
         dy = wc[i, 1] - ref[n_pins + i, 1]
         stale |= not (dx * dx + dy * dy <= lim)
+    n_wc = n_pins + wc.shape[0]
+    for j in range(gc.shape[0]):
+        dx = gc[j, 0] - ref[n_wc + j, 0]
+        dy = gc[j, 1] - ref[n_wc + j, 1]
+        stale |= not (dx * dx + dy * dy <= lim)
     if stale:
-        build_neighbours(apos, wc, par, seg, corners, nbr, rows)
+        build_neighbours(apos, wc, gc, m)
         for b in range(n_pins):
             ref[b, 0] = apos[b, 0]
             ref[b, 1] = apos[b, 1]
         for i in range(wc.shape[0]):
             ref[n_pins + i, 0] = wc[i, 0]
             ref[n_pins + i, 1] = wc[i, 1]
-        counters[C_REBUILDS] += 1
+        for j in range(gc.shape[0]):
+            ref[n_wc + j, 0] = gc[j, 0]
+            ref[n_wc + j, 1] = gc[j, 1]
+        m.counters[C_REBUILDS] += 1
 
 
 @njit(**INLINE)
@@ -132,6 +149,9 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     tmin = np.inf
     tmax = -np.inf
     link_frames(apos, lk)
+    if lk.shape[0] == apos.shape[0]:   # closed loop: one more row, link 0 again, for pin n_links's cap
+        for k in range(lk.shape[1]):
+            lk[lk.shape[0] - 1, k] = lk[0, k]
     for b in range(apos.shape[0] - 1):
         tx = lk[b, LK_TX]
         ty = lk[b, LK_TY]
@@ -356,7 +376,7 @@ def wheel_contacts(w, m, diag, mem):
 
 
 @njit(**INLINE)
-def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
+def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection); in the continuous geometry one
     contact per pin with the ground's nearest point (gaps.ground_distance). acc = (fx,
@@ -372,7 +392,7 @@ def _pins_on_ground(apos, avel, fpin, par, seg, nbr, rows, mem, acc):
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
-    for b in range(1, apos.shape[0] - 1):
+    for b in range(1, last + 1):
         row = first + b
         if continuous:
             inside, n_below, best = False, 0, 0.0
@@ -423,7 +443,7 @@ def _corners(w, m, diag, mem, acc):
 @njit(**INLINE)
 def ground_contacts(w, m, diag, mem):
     """The track against the ground: pins on segments, then the corners."""
-    acc = _pins_on_ground(w.apos, w.avel, w.fpin, m.par, m.seg, m.nbr, m.nbr_rows, mem,
+    acc = _pins_on_ground(w.apos, w.avel, w.fpin, m.pins[PN_LAST], m.par, m.seg, m.nbr, m.nbr_rows, mem,
                           (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     gx, gy, corner_force, energy, power, obstacle, dissipation = _corners(w, m, diag, mem, acc)
     diag[D_E_PAD_GROUND] = energy
@@ -447,7 +467,7 @@ def track_loads(w, m, diag):
     diag[D_POWER] = 0.0
     diag[D_DISSIPATION] = 0.0
     m.counters[C_EVALUATIONS] += 1
-    refresh_neighbours(apos, wc, par, m.seg, m.corners, m.nbr, m.nbr_rows, m.ref, m.counters)
+    refresh_neighbours(apos, wc, m.guides, m)   # m.guides: no rows, as no idler or rollers
     link_tensions(apos, w.avel, par, w.lk, w.fpin, diag, diag_tension(wc.shape[0]))
     wheel_contacts(w, m, diag, mem)
     ground_contacts(w, m, diag, mem)

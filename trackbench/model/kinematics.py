@@ -28,25 +28,22 @@ def wheel_offset(c, s, arms, i, la, cb, sb):
 
 
 @njit(**INLINE)
-def _free_pins(coords, nw, out):
-    """The free pins' coordinates (or velocities: coords = q') into out[1:-1]; the track
-    ends are body points of the chassis."""
-    for b in range(1, out.shape[0] - 1):
+def _free_pins(coords, nw, last, out):
+    """The free pins' coordinates (or velocities: coords = q') into out[1:last + 1]."""
+    for b in range(1, last + 1):
         k = q_pin(nw, b)
         out[b, 0] = coords[k]
         out[b, 1] = coords[k + 1]
 
 
 @njit(**INLINE)
-def place(q, par, arms, ends, apos, wc, arm):
-    """Pin and wheel-centre positions of configuration q into apos and wc; cos and sin of
-    each arm's absolute angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
-    nw = arms.shape[0]
-    n_links = apos.shape[0] - 1
+def place_wheels(q, par, arms, wc, arm):
+    """Road-wheel centres of configuration q into wc; cos and sin of each arm's absolute
+    angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
     c = math.cos(q[Q_PITCH])
     s = math.sin(q[Q_PITCH])
     la = par[P_ARM_LENGTH]
-    for i in range(nw):
+    for i in range(arms.shape[0]):
         beta = q[Q_PITCH] + q[Q_ARM + i]
         cb = math.cos(beta)
         sb = math.sin(beta)
@@ -55,12 +52,35 @@ def place(q, par, arms, ends, apos, wc, arm):
         rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
         wc[i, 0] = q[Q_X] + rx
         wc[i, 1] = q[Q_Y] + ry
+    return c, s
+
+
+@njit(**INLINE)
+def wheel_velocities(qd, par, arms, wv, arm, c, s):
+    """Road-wheel centre velocities (after place_wheels)."""
+    om = qd[Q_PITCH]
+    la = par[P_ARM_LENGTH]
+    for i in range(arms.shape[0]):
+        cb = arm[i, ARM_COS]
+        sb = arm[i, ARM_SIN]
+        rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
+        wv[i, 0] = qd[Q_X] - om * ry - qd[Q_ARM + i] * la * sb
+        wv[i, 1] = qd[Q_Y] + om * rx + qd[Q_ARM + i] * la * cb
+
+
+@njit(**INLINE)
+def place(q, par, arms, ends, apos, wc, arm):
+    """Pin and wheel-centre positions of configuration q into apos and wc (the paper's
+    layout: pins 0 and n_links on the chassis); cos and sin of each arm's absolute angle
+    into arm. Returns (cos, sin) of the pitch."""
+    n_links = apos.shape[0] - 1
+    c, s = place_wheels(q, par, arms, wc, arm)
     for e in range(2):
         b = 0 if e == 0 else n_links
         rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
         apos[b, 0] = q[Q_X] + rx
         apos[b, 1] = q[Q_Y] + ry
-    _free_pins(q, nw, apos)
+    _free_pins(q, arms.shape[0], n_links - 1, apos)
     return c, s
 
 
@@ -68,22 +88,15 @@ def place(q, par, arms, ends, apos, wc, arm):
 def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
     """Positions (place) and velocities of the pins and wheel centres."""
     c, s = place(q, par, arms, ends, apos, wc, arm)
-    nw = arms.shape[0]
     n_links = avel.shape[0] - 1
     om = qd[Q_PITCH]
-    la = par[P_ARM_LENGTH]
-    for i in range(nw):
-        cb = arm[i, ARM_COS]
-        sb = arm[i, ARM_SIN]
-        rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
-        wv[i, 0] = qd[Q_X] - om * ry - qd[Q_ARM + i] * la * sb
-        wv[i, 1] = qd[Q_Y] + om * rx + qd[Q_ARM + i] * la * cb
+    wheel_velocities(qd, par, arms, wv, arm, c, s)
     for e in range(2):
         b = 0 if e == 0 else n_links
         rx, ry = body_offset(c, s, ends[e, 0], ends[e, 1])
         avel[b, 0] = qd[Q_X] - om * ry
         avel[b, 1] = qd[Q_Y] + om * rx
-    _free_pins(qd, nw, avel)
+    _free_pins(qd, arms.shape[0], n_links - 1, avel)
     return c, s
 
 

@@ -16,6 +16,12 @@ Reduced-coordinate state ``y`` (length ``2 * nq + 2``)::
 Pins are numbered 0..n_links from the front track end to the rear one; pins 0 and
 n_links are fixed to the chassis. Link b joins pins b and b+1.
 
+The closed layout (track.layout = "closed") has n_links pins, all free, clockwise around
+the loop: rows 1..n_links of the pin arrays hold them (q_pin as above), and row 0 is a
+copy of row n_links, so that link b still joins rows b and b+1 (link 0 closes the loop).
+After the pin coordinates come the sprocket's angle relative to the chassis
+(q_sprocket) and the idler carrier's slide along its guide (q_idler).
+
 Absolute state ``z`` of the "lee" solver (model/absolute.py)::
 
     z[Z_X], z[Z_Y], z[Z_PITCH]              chassis mass centre and pitch
@@ -47,7 +53,9 @@ def q_pin(n_wheels, b):
 
 Y_WORK = 0               # y[2 nq + Y_WORK]: W
 Y_DISSIPATED = 1         # y[2 nq + Y_DISSIPATED]: D
-N_Y_EXTRA = 2            # first-order components after (q, qd); the error test leaves them out
+Y_DRIVE_WORK = 2         # work done by the drive on the sprocket (J; closed layout)
+Y_DRIVE_INTEGRAL = 3     # integral of the speed error of the speed drive's PI controller (m)
+N_Y_EXTRA = 4            # first-order components after (q, qd); the error test leaves them out
 
 
 def n_state(nq):
@@ -59,8 +67,20 @@ def nq_of(ny):
     return (ny - N_Y_EXTRA) // 2
 
 
-def n_coordinates(n_wheels, n_links):
+def n_coordinates(n_wheels, n_links, closed=False):
+    if closed:
+        return Q_ARM + n_wheels + 2 * n_links + 2   # pins, sprocket, idler
     return Q_ARM + n_wheels + 2 * (n_links - 1)
+
+
+def q_sprocket(n_wheels, n_links):
+    """Index in q of the sprocket angle relative to the chassis (closed layout; rad, CCW)."""
+    return Q_ARM + n_wheels + 2 * n_links
+
+
+def q_idler(n_wheels, n_links):
+    """Index in q of the idler carrier's slide along its guide (closed layout; m, outward)."""
+    return Q_ARM + n_wheels + 2 * n_links + 1
 
 
 # --- absolute coordinates of the lee solver ------------------------------------------
@@ -120,16 +140,20 @@ K_WHEEL_PIN = 1          # row: wheel i; entries: free pins b      (Fig. 4)
 K_CORNER_LINK = 2        # row: corner c; entries: links b         (Fig. 5 right)
 K_CORNER_PIN = 3         # row: corner c; entries: free pins b     (Fig. 6)
 K_PIN_GROUND = 4         # row: pin b (0..n_links); entries: segments j   (Fig. 5 left, Eq. 6)
-N_KINDS = 5
+K_GUIDE_LINK = 5         # row: idler or roller j; entries: links b (closed layout)
+K_GUIDE_PIN = 6          # row: idler or roller j; entries: free pins b
+N_KINDS = 7
+N_EVENT_KINDS = 5        # the kinds whose onsets the event location finds (the paper's)
 
 
-def neighbour_rows(n_wheels, n_corners, n_links):
+def neighbour_rows(n_wheels, n_corners, n_links, n_guides=0):
     """First row of each kind's block in the candidate lists, and the total row count
     at [N_KINDS]; the kernels get this as ``nbr_rows``."""
     counts = [0] * N_KINDS
     counts[K_WHEEL_LINK] = counts[K_WHEEL_PIN] = n_wheels
     counts[K_CORNER_LINK] = counts[K_CORNER_PIN] = n_corners
     counts[K_PIN_GROUND] = n_links + 1
+    counts[K_GUIDE_LINK] = counts[K_GUIDE_PIN] = n_guides
     starts = [0]
     for c in counts:
         starts.append(starts[-1] + c)
@@ -142,6 +166,57 @@ def neighbour_width(n_links, n_segments):
 
 
 NB_COUNT = 0             # column of the candidate count; entries follow in 1..count
+
+# --- which pin rows are free, ``pins`` (int) -------------------------------------------
+PN_LAST = 0              # last free pin row: n_links - 1 (paper: pin n_links rides on the chassis), n_links (closed)
+PN_CLOSED = 1            # 1: closed loop (row 0 copies row n_links), 0: the paper's ends on the chassis
+N_PN = 2
+
+# --- sprocket, idler, tensioner and drive of the closed layout, ``loop`` (empty: paper) --
+LP_SPROCKET_X = 0        # body point of the sprocket axis (m)
+LP_SPROCKET_Y = 1
+LP_SPROCKET_INERTIA = 2  # about its axis (kg m^2)
+LP_TEETH = 3             # tooth count N
+LP_PITCH_RADIUS = 4      # r_p: seat centres (m)
+LP_SEAT_RADIUS = 5       # radius of the circular seat between two teeth (m)
+LP_TIP_RADIUS = 6        # tooth tips (m)
+LP_PIN_RADIUS = 7        # radius of a pin where it meets the teeth (m)
+LP_TOOTH_STIFFNESS = 8   # pin-tooth penalty stiffness (N/m, or N/m^n for the power law)
+LP_TOOTH_DAMPING = 9     # viscous coefficient of pin-tooth contacts (N s/m)
+LP_GUIDE_X = 10          # unit direction of the idler's guide, body frame (outward)
+LP_GUIDE_Y = 11
+LP_IDLER_MASS = 12       # idler wheel + carrier (kg)
+LP_PRELOAD = 13          # tensioner force at slide 0 (N)
+LP_TENSIONER_STIFFNESS = 14  # (N/m)
+LP_TENSIONER_DAMPING = 15    # (N s/m)
+LP_DRIVE_KIND = 16       # DRIVE_* code (model/drive.py)
+LP_DRIVE_TORQUE = 17     # torque of the torque drive (N m, forward positive)
+LP_TARGET = 18           # speed of the speed drive (m/s)
+LP_GAIN_P = 19           # PI gains of the speed drive (N m per m/s, N m per m)
+LP_GAIN_I = 20
+LP_TORQUE_LIMIT = 21     # |torque| of the speed drive at most this (N m)
+LP_TRAVEL = 22           # the idler's slide stays within +-travel (m)
+LP_CURVE = 23            # torque-speed curve: LP_CURVE_POINTS pairs (sprocket speed rad/s, torque N m) after it
+LP_CURVE_POINTS = 16
+N_LOOP = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # [LP_CURVE] holds the number of points used
+
+# --- idler and support rollers, ``guides`` (row 0 the idler, then the rollers) ---------
+G_BX = 0                 # body point of the centre (the idler's at slide 0) (m)
+G_BY = 1
+G_REACH = 2              # wheel radius + pad h_w (m)
+N_G_COLS = 3
+
+# --- the sprocket's kinematics and loads, LoopWork.spr ------------------------------------
+SP_X = 0                 # axis position and velocity (world)
+SP_Y = 1
+SP_VX = 2
+SP_VY = 3
+SP_ANGLE = 4             # absolute angle and rate (CCW)
+SP_RATE = 5
+SP_FX = 6                # out: force of the pins on the sprocket
+SP_FY = 7
+SP_TORQUE = 8            # out: their torque about the axis (CCW)
+N_SP = 9
 
 # --- run counters of the model arrays, ``counters`` -----------------------------------
 C_REBUILDS = 0           # candidate-list rebuilds
@@ -205,7 +280,10 @@ D_MIN_TENSION = 13
 D_MAX_TENSION = 14
 D_OBSTACLE_FORCE = 15    # ground force on the track from obstacles: corners and every segment after the first (N)
 D_DISSIPATION = 16       # dD/dt: power dissipated by all dampers (W)
-D_WHEEL = 17             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
+D_DRIVE_TORQUE = 17      # torque of the drive on the sprocket, forward positive (N m; closed layout)
+D_IDLER_FORCE = 18       # tensioner force along the guide, outward positive (N)
+D_TEETH_TORQUE = 19      # torque of the pins on the sprocket, forward positive (N m)
+D_WHEEL = 20             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
 def diag_tension(n_wheels):

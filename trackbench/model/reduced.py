@@ -24,11 +24,25 @@ from .layout import (
 
 
 @njit(**INLINE)
-def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
-    """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), every arm +
-    road wheel added; the coupling B_i of each arm and its generalised force (torsion bar
-    included) into w.arm. Returns (A, f, (kinetic, torsion, gravity energies), power
-    dissipated by the shock absorbers)."""
+def _track_ends(q, par, apos, fpin):
+    """Generalised force on (x, y, pitch) of the pins riding on the chassis (the paper's
+    track ends, pins 0 and n_links) and the chassis weight."""
+    last = apos.shape[0] - 1
+    qx = fpin[0, 0] + fpin[last, 0]
+    qy = fpin[0, 1] + fpin[last, 1] - par[P_CHASSIS_MASS] * par[P_GRAVITY]
+    qt = 0.0
+    for e in range(2):
+        b = 0 if e == 0 else last
+        qt += (apos[b, 0] - q[Q_X]) * fpin[b, 1] - (apos[b, 1] - q[Q_Y]) * fpin[b, 0]
+    return qx, qy, qt
+
+
+@njit(**INLINE)
+def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
+    """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), starting
+    from f0 (what acts on the chassis itself), every arm + road wheel added; the coupling
+    B_i of each arm and its generalised force (torsion bar included) into w.arm. Returns
+    (A, f, (kinetic, torsion, gravity energies), power dissipated by the shock absorbers)."""
     mc = par[P_CHASSIS_MASS]
     ma = par[P_ARM_MASS]
     ia = par[P_ARM_INERTIA]
@@ -36,19 +50,13 @@ def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
     kt = par[P_TORSION_STIFFNESS]
     g = par[P_GRAVITY]
     om = qd[Q_PITCH]
-    last = apos.shape[0] - 1
     a00 = mc
     a11 = mc
     a22 = par[P_CHASSIS_INERTIA]
     a01 = 0.0
     a02 = 0.0
     a12 = 0.0
-    qx = fpin[0, 0] + fpin[last, 0]
-    qy = fpin[0, 1] + fpin[last, 1] - mc * g
-    qt = 0.0
-    for e in range(2):
-        b = 0 if e == 0 else last
-        qt += (apos[b, 0] - q[Q_X]) * fpin[b, 1] - (apos[b, 1] - q[Q_Y]) * fpin[b, 0]
+    qx, qy, qt = f0
     ke = 0.5 * mc * (qd[Q_X] ** 2 + qd[Q_Y] ** 2) + 0.5 * a22 * om * om
     e_tors = 0.0
     dissipation = 0.0
@@ -91,7 +99,7 @@ def _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s):
 
 
 @njit(**INLINE)
-def _chassis_acceleration(arm, d, a, f):
+def chassis_acceleration(arm, d, a, f):
     """(ax, ay, alpha) of the chassis: the Schur complement S = A - sum B_i B_i^T / d and
     its right side, solved by cofactors (3x3 symmetric). d: the arms' diagonal mass."""
     s00, s01, s02, s11, s12, s22 = a
@@ -122,11 +130,11 @@ def _chassis_acceleration(arm, d, a, f):
 
 
 @njit(**INLINE)
-def _pins(par, nw, apos, avel, fpin, acc, ke, e_grav):
-    """Free pins: point masses under tension, contact forces and gravity."""
+def pin_accelerations(par, nw, last, apos, avel, fpin, acc, ke, e_grav):
+    """Free pins (rows 1..last): point masses under tension, contact forces and gravity."""
     mp = par[P_PIN_MASS]
     g = par[P_GRAVITY]
-    for b in range(1, apos.shape[0] - 1):
+    for b in range(1, last + 1):
         k = q_pin(nw, b)
         acc[k] = fpin[b, 0] / mp
         acc[k + 1] = fpin[b, 1] / mp - g
@@ -145,9 +153,10 @@ def reduced_rhs(y, m, w, ydot, diag):
     qd = y[nq:2 * nq]
     c, s = positions(q, qd, par, arms, m.ends, apos, avel, wc, wv, arm)
     track_loads(w, m, diag)
-    a, f, e, arm_dissipation = _chassis_and_arms(q, qd, par, arms, apos, fpin, fwheel, wv, wc, arm, c, s)
+    a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s,
+                                                _track_ends(q, par, apos, fpin))
     d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal
-    ax, ay, at = _chassis_acceleration(arm, d, a, f)
+    ax, ay, at = chassis_acceleration(arm, d, a, f)
     for k in range(nq):
         ydot[k] = qd[k]
     acc = ydot[nq:2 * nq]
@@ -157,7 +166,7 @@ def reduced_rhs(y, m, w, ydot, diag):
     for i in range(arm.shape[0]):
         acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
     ke, e_tors, e_grav = e
-    ke, e_grav = _pins(par, arms.shape[0], apos, avel, fpin, acc, ke, e_grav)
+    ke, e_grav = pin_accelerations(par, arms.shape[0], apos.shape[0] - 2, apos, avel, fpin, acc, ke, e_grav)
     diag[D_DISSIPATION] += arm_dissipation
     ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation  # dW/dt: contact forces and dampers
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]

@@ -24,7 +24,7 @@ from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.index import nq_of, q_pin
 from ..model.layout import (
-    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_EVENT_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
 )
 from .hermite import coordinate, quintic_basis
 
@@ -152,7 +152,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     step = (y0, f0, y1, f1, h)
     ramp = m.par[P_DAMPING_RAMP] if m.par[P_CONTACT_DAMPING] == DAMPING_VISCOUS else -1.0
     best = 2.0
-    for kind in range(N_KINDS):
+    for kind in range(N_EVENT_KINDS):
         for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, NB_COUNT]):

@@ -16,11 +16,10 @@ from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.index import nq_of
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
-from ..model.reduced import reduced_rhs
+from ..model.rhs import contact_switch, rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step, counted, finish_stats, loop_start
-from .events import first_contact_switch
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
 
@@ -29,7 +28,7 @@ LoopWork = namedtuple("LoopWork", [
     "y",      # (ny,) state at the step start
     "y_new",  # (ny,) state at the step end
     "ys",     # (ny,) stage state, then the state at an output sample
-    "fs",     # (ny,) derivative at an output sample (unused but required by reduced_rhs)
+    "fs",     # (ny,) derivative at an output sample (unused but required by the right-hand side)
     "er5",    # (ny,) error estimate, 5th order
     "er3",    # (ny,) error estimate, 3rd order (DOP853)
     "diag",   # (n_diag,) diagnostics of the last evaluation
@@ -93,7 +92,7 @@ def _start(y0, m, w, lw, out):
     ny = y0.shape[0]
     nq = nq_of(ny)
     copy_into(lw.y, 0, y0)
-    reduced_rhs(lw.y, m, w, lw.K[0], lw.diag)
+    rhs(lw.y, m, w, lw.K[0], lw.diag)
     e_ref = energy_balance(lw.diag)
     r_ref = energy_residual(lw.diag, lw.y[2 * nq + Y_WORK])
     out.stats[S_E0] = e_ref - lw.diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
@@ -114,9 +113,9 @@ def _stages(h, A, b, m, w, y, K, ys, y_new, diag):
     s = b.shape[0]
     for i in range(1, s):
         _combine(y, h, A[i], K, i, ys)
-        reduced_rhs(ys, m, w, K[i], diag)
+        rhs(ys, m, w, K[i], diag)
     _combine(y, h, b, K, s, y_new)
-    reduced_rhs(y_new, m, w, K[s], diag)
+    rhs(y_new, m, w, K[s], diag)
 
 
 @njit(**INLINE)
@@ -131,7 +130,7 @@ def _samples(t, h, n_out, dt_out, m, w, lw, out):
         theta = min(1.0, (n_out * dt_out - t) / h)
         hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
         set_row(out_y, n_out, ys)
-        reduced_rhs(ys, m, w, fs, out_diag[n_out])
+        rhs(ys, m, w, fs, out_diag[n_out])
         n_out += 1
     return n_out
 
@@ -173,14 +172,14 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
             th = 2.0
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
-                th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
+                th = contact_switch(y, K[0], y_new, K[s], h, m, w, ev)
             h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
         if onset_in_step(m, w):
             # a contact whose law remembers its approach speed began inside the step:
             # end the step at the onset (if located before the end) and take it there
-            th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
+            th = contact_switch(y, K[0], y_new, K[s], h, m, w, ev)
             if th < 1.0 and th * h > h_min:
                 rejected += 1
                 h *= th

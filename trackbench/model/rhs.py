@@ -1,0 +1,50 @@
+"""The right-hand side of the reduced solver for either track layout, chosen by the type
+of the scratch bundle when the solver compiles: a run of the paper's layout never
+compiles the closed layout's code (and the other way round)."""
+
+from numba.extending import overload
+
+from .bundles import LoopWork
+from .loop import loop_rhs
+from .reduced import reduced_rhs
+
+
+def _closed(w):
+    return getattr(w, "instance_class", None) is LoopWork
+
+
+def rhs(y, m, w, ydot, diag):
+    """ydot = f(y): reduced.reduced_rhs (paper's layout) or loop.loop_rhs (closed)."""
+    if isinstance(w, LoopWork):
+        return loop_rhs(y, m, w, ydot, diag)
+    return reduced_rhs(y, m, w, ydot, diag)
+
+
+@overload(rhs, jit_options={"cache": True})
+def _rhs(y, m, w, ydot, diag):
+    if _closed(w):
+        return lambda y, m, w, ydot, diag: loop_rhs(y, m, w, ydot, diag)
+    return lambda y, m, w, ydot, diag: reduced_rhs(y, m, w, ydot, diag)
+
+
+def contact_switch(y0, f0, y1, f1, h, m, w, ev):
+    """solvers/events.first_contact_switch for the paper's layout; the closed layout's
+    steps are not cut at contact switches (2.0: none located), the step-size control
+    alone takes them."""
+    from ..solvers.events import first_contact_switch
+    if isinstance(w, LoopWork):
+        return 2.0
+    return first_contact_switch(y0, f0, y1, f1, h, m, ev)
+
+
+@overload(contact_switch, jit_options={"cache": True})
+def _contact_switch(y0, f0, y1, f1, h, m, w, ev):
+    from ..solvers.events import first_contact_switch
+    if _closed(w):
+        return lambda y0, f0, y1, f1, h, m, w, ev: 2.0
+    return lambda y0, f0, y1, f1, h, m, w, ev: first_contact_switch(y0, f0, y1, f1, h, m, ev)
+
+
+def is_closed(w):
+    """True where w is the closed layout's scratch (plain Python)."""
+    return isinstance(w, LoopWork)
