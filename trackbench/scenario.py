@@ -15,7 +15,8 @@ import numpy as np
 
 from .model.contact_laws import DAMPINGS, GEOMETRIES, LAWS
 
-from .model.parameters import GRAVITY, paper_contact, paper_track, paper_vehicle, wheel_centres_body
+from .model.drive import DRIVES
+from .model.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle, wheel_centres_body
 from .presets import PRESETS, preset_values
 
 SOLVERS = ("reduced", "lee")
@@ -48,6 +49,7 @@ def paper_step():
         "track": paper_track(),
         "contact": paper_contact(),
         "terrain": {"kind": "step", "height": 0.1, "first_contact_time": 0.0568},
+        **closed_defaults(),
         "lee": {"accel_order": 10, "eps_iterations": 10, "position_tol": 1e-9,
                 "max_iterations": 500, "matrix_update_angle": 1e-3},
         "record": {"enabled": True, "every": 5},   # side-view frames: every 5th output sample
@@ -104,6 +106,32 @@ RULES = {
     "contact.geometry": (str, tuple(GEOMETRIES), None, "one of " + ", ".join(GEOMETRIES)),
     "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
     "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
+    "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
+    "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
+    "sprocket.position": (str, ("rear", "front"), None, "one of rear, front"),
+    "sprocket.teeth": (int, 3, 60, "an integer in [3, 60]"),
+    "sprocket.pitch_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived from the link pitch)"),
+    "sprocket.seat_radius": _POS,
+    "sprocket.pin_radius": _POS,
+    "sprocket.tip_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived)"),
+    "sprocket.stiffness": _POS,
+    "sprocket.inertia": _POS,
+    "idler.radius": _POS,
+    "idler.mass": _POS,
+    "idler.preload": (float, 0.0, 1e8, "a number >= 0 (N; 0: derived from track.tension)"),
+    "idler.stiffness": _NONNEG,
+    "idler.damping": _NONNEG,
+    "idler.travel": _POS,
+    "idler.guide_angle": (float, -60.0, 60.0, "a number in [-60, 60] deg"),
+    "rollers.positions": (list, None, None, "a list of [x, y] body points (m), or []"),
+    "rollers.radius": _POS,
+    "drive.kind": (str, tuple(DRIVES), None, "one of " + ", ".join(DRIVES)),
+    "drive.torque": (float, -1e7, 1e7, "a number in [-1e7, 1e7] N m"),
+    "drive.curve": (list, None, None, "a list of [sprocket speed rad/s, torque N m] pairs, speeds increasing, or []"),
+    "drive.target": (float, -100.0, 100.0, "a number in [-100, 100] m/s"),
+    "drive.gain_p": _NONNEG,
+    "drive.gain_i": _NONNEG,
+    "drive.torque_limit": _POS,
     "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
@@ -294,7 +322,8 @@ def validate_terrain(t):
 
 
 def _check_geometry(v, tr):
-    """Does the track fit the wheels? Cheap checks on the equilibrium configuration."""
+    """Does the track fit the wheels? Cheap checks on the equilibrium configuration (the
+    closed layout's own: _check_closed)."""
     from .model.track_path import initial_track
     wc = wheel_centres_body(v)
     r = v["wheel_radius"]
@@ -312,6 +341,10 @@ def _check_geometry(v, tr):
                             "last road wheel (wheel radius and pad included)")
     if np.any(ends[:, 1] <= wc[:, 1].min() - rho + tr["pad_ground"]):
         raise ScenarioError("vehicle.front_track_end / rear_track_end must lie above the bottom of the road wheels")
+    if tr["link_length"] <= 2 * tr["pad_ground"]:
+        raise ScenarioError("track.link_length must exceed 2 * track.pad_ground")
+    if tr["layout"] == "closed":
+        return
     _, path, _ = initial_track(ends, wc, rho, tr["n_links"])
     free = tr["n_links"] * tr["link_length"]
     strain = path / free - 1.0
@@ -321,8 +354,51 @@ def _check_geometry(v, tr):
     if strain > 0.1:
         raise ScenarioError(f"the track is too short for the wheels: the links would stretch {100 * strain:.3g} % "
                             f"(n_links * link_length = {free:.4g} m, path {path:.4g} m); allowed: at most 10 %")
-    if tr["link_length"] <= 2 * tr["pad_ground"]:
-        raise ScenarioError("track.link_length must exceed 2 * track.pad_ground")
+
+
+_CLOSED_GROUPS = ("sprocket", "idler", "rollers", "drive")
+
+
+def _pairs(name, value, increasing=False, limit=None):
+    arr = np.asarray(value, dtype=float) if value else np.zeros((0, 2))
+    if arr.ndim != 2 or arr.shape[1] != 2 or not np.all(np.isfinite(arr)):
+        raise ScenarioError(f"{name} must be a list of [a, b] pairs of finite numbers, or []")
+    if increasing and np.any(np.diff(arr[:, 0]) <= 0):
+        raise ScenarioError(f"{name}: the speeds must increase from pair to pair")
+    if limit is not None and len(arr) > limit:
+        raise ScenarioError(f"{name} has {len(arr)} pairs; allowed: at most {limit}")
+    return arr.tolist()
+
+
+def _check_closed(out, explicit):
+    """The closed layout: what it supports, its geometry (model/closed.py), and the values
+    it derives written into the scenario unless given."""
+    from .model.closed import ClosedLayoutError, closed_geometry
+    from .model.layout import LP_CURVE_POINTS
+    closed = out["track"]["layout"] == "closed"
+    if not closed:
+        given = sorted(k for k in explicit if k.split(".")[0] in _CLOSED_GROUPS or k == "track.tension")
+        if given:
+            raise ScenarioError(f"{given[0]} applies to the closed track only; set track.layout = 'closed'")
+        return
+    if out["solver"] == "lee":
+        raise ScenarioError("solver = 'lee' runs the paper's track layout only; use solver = 'reduced' with "
+                            "track.layout = 'closed'")
+    if out["contact"]["damping"] not in ("none", "viscous"):
+        raise ScenarioError(f"contact.damping = '{out['contact']['damping']}' does not apply to the closed track's "
+                            "sprocket teeth; allowed with track.layout = 'closed': none, viscous")
+    out["rollers"]["positions"] = _pairs("rollers.positions", out["rollers"]["positions"])
+    out["drive"]["curve"] = _pairs("drive.curve", out["drive"]["curve"], True, LP_CURVE_POINTS)
+    if out["drive"]["kind"] == "torque" and "drive.torque" not in explicit and not out["drive"]["curve"]:
+        raise ScenarioError("drive.kind = 'torque' needs drive.torque (N m) or drive.curve")
+    try:
+        g = closed_geometry(out["vehicle"], out["track"], out["sprocket"], out["idler"], out["rollers"],
+                            frozenset(explicit))
+    except ClosedLayoutError as e:
+        raise ScenarioError(str(e)) from None
+    for name, value in g.resolved().items():
+        if name not in explicit:
+            set_dotted(out, name, value)
 
 
 def _dotted_keys(d, prefix=""):
@@ -445,4 +521,5 @@ def validate(d, explicit=frozenset()):
     _check_geometry(out["vehicle"], out["track"])
     out["vehicle"]["arm_damping"] = [float(a) for a in out["vehicle"]["arm_damping"]]
     _check_extensions(out, explicit)
+    _check_closed(out, explicit)
     return out

@@ -25,25 +25,80 @@ def _equilibrium_cached(key):
     return solve_equilibrium(vehicle, track, gravity, contact)
 
 
+def _closed(scenario):
+    return scenario["track.layout"] == "closed"
+
+
+def _closed_key(scenario):
+    return json.dumps([scenario[k] for k in ("vehicle", "track", "gravity", "contact", "sprocket", "idler",
+                                             "rollers", "drive")], sort_keys=True)
+
+
+@functools.lru_cache(maxsize=32)
+def _closed_parts_cached(key):
+    from .model.closed import closed_geometry, guide_table, loop_vector
+    vehicle, track, gravity, contact, spr, idl, rol, drive = json.loads(key)
+    g = closed_geometry(vehicle, track, spr, idl, rol, frozenset({"track.n_links"}))
+    c = 0.0
+    if contact["damping"] == "viscous":   # the contacts' rule: c = 2 zeta sqrt(k m_pin)
+        c = 2.0 * contact["damping_ratio"] * np.sqrt(spr["stiffness"] * track["pin_mass"])
+    return g, loop_vector(g, spr, idl, drive, c), guide_table(g, track, idl, rol)
+
+
+def closed_parts(scenario: Scenario):
+    """The closed layout's geometry, LP_* vector and guide table (cached), or None."""
+    return _closed_parts_cached(_closed_key(scenario)) if _closed(scenario) else None
+
+
+@functools.lru_cache(maxsize=32)
+def _loop_equilibrium_cached(key):
+    from .model.equilibrium import solve_loop_equilibrium
+    vehicle, track, gravity, contact, *_ = json.loads(key)
+    g, lp, guides = _closed_parts_cached(key)
+    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, lp, guides)
+
+
 def equilibrium(scenario: Scenario):
     """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
+    if _closed(scenario):
+        return _loop_equilibrium_cached(_closed_key(scenario))
     key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"]],
                      sort_keys=True)
     return _equilibrium_cached(key)
 
 
+def _loop_velocities(scenario, eq, y0):
+    """The closed track moving at `speed` without slip on the ground: every pin runs round
+    the loop (clockwise, along its neighbours' chord) at `speed` relative to the chassis,
+    the sprocket turns to match."""
+    nq = eq.q.size
+    nw, n = scenario["vehicle.n_wheels"], scenario["track.n_links"]
+    v = scenario["speed"]
+    off = L.pin_offset(nw)
+    pins = eq.q[off:off + 2 * n].reshape(n, 2)
+    chord = np.roll(pins, -1, axis=0) - np.roll(pins, 1, axis=0)
+    rel = v * chord / np.hypot(*chord.T)[:, None]
+    y0[nq + off:nq + off + 2 * n] = (rel + [v, 0.0]).ravel()
+    g = closed_parts(scenario)[0]
+    y0[nq + L.q_sprocket(nw, n)] = -v / g.pitch_radius
+
+
 def initial_state(scenario: Scenario, eq):
-    """y0 = (q, qd, W): the equilibrium moving at `speed`, pins nudged if asked."""
+    """y0 = (q, qd, W, ...): the equilibrium moving at `speed`, pins nudged if asked."""
     nq = eq.q.size
     y0 = np.zeros(L.n_state(nq))
     y0[:nq] = eq.q
     nw = scenario["vehicle.n_wheels"]
     off = L.pin_offset(nw)
     y0[nq + L.Q_X] = scenario["speed"]
-    y0[nq + off:2 * nq:2] = scenario["speed"]
+    end = off + 2 * scenario["track.n_links"] if _closed(scenario) else nq
+    if _closed(scenario):
+        _loop_velocities(scenario, eq, y0)
+    else:
+        y0[nq + off:2 * nq:2] = scenario["speed"]
     if scenario["perturbation"] > 0.0:
         rng = np.random.default_rng(scenario["seed"])
-        y0[off:nq] += scenario["perturbation"] * rng.uniform(-1.0, 1.0, nq - off)
+        y0[off:end] += scenario["perturbation"] * rng.uniform(-1.0, 1.0, end - off)
     return y0
 
 
@@ -57,9 +112,13 @@ class Model:
         self.nw = int(v["n_wheels"])
         self.n_links = int(tr["n_links"])
         arms = arm_table(piv, eq.phi0, arm_damping(v))
-        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links)
+        parts = closed_parts(scenario)
+        self.closed = parts is not None
+        loop, guides = (parts[1], parts[2]) if self.closed else (None, None)
+        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides)
         self.work = work_arrays(self.arrays, self.nw, self.n_links)
-        self.weight = total_mass(v, tr) * scenario["gravity"]
+        self.weight = eq.weight if self.closed else total_mass(v, tr) * scenario["gravity"]
+        self.nq = L.n_coordinates(self.nw, self.n_links, self.closed)
 
     @property
     def par(self):

@@ -13,11 +13,12 @@ import numpy as np
 from numba import njit
 
 from . import layout as L
-from .index import n_coordinates, n_state
+from .index import n_coordinates, n_state, pin_offset, q_idler, q_sprocket
 from .jit import KERNEL
 from .bundles import arm_table, model_arrays, work_arrays
 from .parameters import equilibrium_arm_angle, pack, total_mass
-from .reduced import reduced_rhs
+from .loop import loop_rhs
+from .rhs import rhs
 from .terrain import flat_ground
 from .track_path import initial_track
 
@@ -132,7 +133,7 @@ def _loads_at_rest(q, m, w, diag):
     for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
         y[k] = q[k]
     ydot = np.empty(n_state(nq))
-    reduced_rhs(y, m, w, ydot, diag)
+    rhs(y, m, w, ydot, diag)
 
 
 @njit(**KERNEL)
@@ -186,7 +187,11 @@ def _newton(P, u, target, max_iter):
     it = 0
     while norm > target and it < max_iter:
         it += 1
-        du = np.linalg.solve(P.jacobian(u), -r)
+        J = P.jacobian(u)
+        try:
+            du = np.linalg.solve(J, -r)
+        except np.linalg.LinAlgError:   # e.g. the closed loop before its pins press on the teeth
+            du = np.linalg.lstsq(J, -r, rcond=None)[0]
         lam = 1.0
         while True:
             un = u + lam * du
@@ -253,3 +258,118 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_
         ground_force=float(P.diag[L.D_GROUND_FY]), weight=P.weight,
         residual=float(max(np.abs(r).max(), abs(fx))), iterations=it,
         info={"pins": apos.copy(), "wheel_centres": wc.copy()})
+
+
+# --- the closed layout ---------------------------------------------------------------
+
+
+class _LoopProblem(_Problem):
+    """The closed layout at rest: unknowns u = (y_c, pitch, idler slide, every pin), the
+    arms at the equilibrium angle, the sprocket held at the angle that seats the pins."""
+
+    def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides):
+        from .closed import loop_pins
+        self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
+        self.nw = int(vehicle["n_wheels"])
+        self.n_links = geometry.n_links
+        self.phi = equilibrium_arm_angle(vehicle)
+        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
+        g = flat_ground()
+        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links, loop, guides)
+        self.work = work_arrays(self.m, self.nw, self.n_links)
+        self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
+        self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
+        self.pins, self.psi = loop_pins(geometry)
+        self.slide0 = geometry.slide
+        self.weight = (total_mass(vehicle, track) + track["pin_mass"] + loop[L.LP_IDLER_MASS]) * gravity
+
+    def q_of(self, u):
+        q = np.zeros(self.nq)
+        q[L.Q_Y] = u[0]
+        q[L.Q_PITCH] = u[1]
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
+        q[L.q_idler(self.nw, self.n_links)] = u[2]
+        q[L.q_sprocket(self.nw, self.n_links)] = self.psi
+        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[3:]
+        return q
+
+    def _args(self):
+        return self.phi, self.psi, self.m, self.work, self.diag
+
+    def residual(self, u):
+        r = np.empty(u.size)
+        arm_moment = np.empty(self.nw)
+        fx = _loop_residual(u, *self._args(), r, arm_moment)
+        return r, fx, arm_moment
+
+    def jacobian(self, u, h=1e-7):
+        args = self._args()
+        rp, rm, am = np.empty(u.size), np.empty(u.size), np.empty(self.nw)
+        J = np.empty((u.size, u.size))
+        up = u.copy()
+        for k in range(u.size):
+            up[k] = u[k] + h
+            _loop_residual(up, *args, rp, am)
+            up[k] = u[k] - h
+            _loop_residual(up, *args, rm, am)
+            up[k] = u[k]
+            J[:, k] = (rp - rm) / (2.0 * h)
+        return J
+
+
+@njit(**KERNEL)
+def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
+    """The closed layout's generalised forces at rest (loop.loop_rhs fills w.genf) on the
+    unknowns into r, each arm's moment about its pivot; returns the horizontal force."""
+    nw = m.arms.shape[0]
+    n = w.apos.shape[0] - 1
+    nq = w.genf.shape[0]
+    y = np.zeros(n_state(nq))
+    y[L.Q_Y] = u[0]
+    y[L.Q_PITCH] = u[1]
+    for i in range(nw):
+        y[L.Q_ARM + i] = phi
+    y[q_idler(nw, n)] = u[2]
+    y[q_sprocket(nw, n)] = psi
+    off = pin_offset(nw)
+    for k in range(2 * n):
+        y[off + k] = u[3 + k]
+    ydot = np.empty(y.shape[0])
+    loop_rhs(y, m, w, ydot, diag)
+    r[0] = w.genf[L.Q_Y]
+    r[1] = w.genf[L.Q_PITCH]
+    r[2] = w.genf[q_idler(nw, n)]
+    for k in range(2 * n):
+        r[3 + k] = w.genf[off + k]
+    for i in range(nw):
+        arm_moment[i] = w.genf[L.Q_ARM + i]
+    return w.genf[L.Q_X]
+
+
+def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, guides, tol_rel=1e-12, max_iter=60):
+    """Static equilibrium of the closed layout on flat ground: Newton's method from the
+    taut loop (model/closed.py) resting on the ground, the sprocket held."""
+    P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides)
+    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
+    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
+    yc = -wcb[:, 1].min() + rho + P.par[L.P_PAD_GROUND]
+    u = np.concatenate([[yc, 0.0, P.slide0], (P.pins + [0.0, yc]).ravel()])
+    u, norm, it = _continuation(P, u, tol_rel * P.weight, max_iter)
+    if not np.isfinite(norm) or norm > 1e-6 * P.weight:
+        raise EquilibriumError(
+            f"static equilibrium of the closed track not found: force residual {norm:.3g} N after {it} Newton "
+            f"iterations (needs < {1e-6 * P.weight:.3g} N); check the sprocket, idler and track values")
+    r, fx, arm_moment = P.residual(u)
+    q = P.q_of(u)
+    preload = -arm_moment
+    phi0 = q[L.Q_ARM:L.Q_ARM + P.nw] + preload / P.par[L.P_TORSION_STIFFNESS]
+    apos, fpin, fwheel, wc = P.loads(q)
+    tension = P.diag[L.diag_tension(P.nw):L.diag_tension(P.nw) + P.n_links].copy()
+    w = P.work
+    return Equilibrium(
+        q=q, phi0=phi0, preload=preload, wheel_load=fwheel[:, 1].copy(), tension=tension,
+        ground_force=float(P.diag[L.D_GROUND_FY]), weight=P.weight,
+        residual=float(max(np.abs(r).max(), abs(fx))), iterations=it,
+        info={"pins": apos[1:].copy(), "wheel_centres": wc.copy(), "idler_slide": float(u[2]),
+              "idler_force": float(P.diag[L.D_IDLER_FORCE]), "holding_torque": float(-w.spr[L.SP_TORQUE]),
+              "guide_forces": w.fguide.copy()})

@@ -150,8 +150,8 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     tmax = -np.inf
     link_frames(apos, lk)
     if lk.shape[0] == apos.shape[0]:   # closed loop: one more row, link 0 again, for pin n_links's cap
-        for k in range(lk.shape[1]):
-            lk[lk.shape[0] - 1, k] = lk[0, k]
+        for col in range(lk.shape[1]):
+            lk[lk.shape[0] - 1, col] = lk[0, col]
     for b in range(apos.shape[0] - 1):
         tx = lk[b, LK_TX]
         ty = lk[b, LK_TY]

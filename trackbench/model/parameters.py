@@ -46,6 +46,47 @@ def paper_track():
         "wheel_stiffness": 1.0e8,         # k_w, Eq. (4) (N/m)
         "ground_stiffness": 1.0e8,        # k_g, Eq. (6) (N/m)
         "link_damping": 0.0,              # axial dashpot parallel to each link spring (N s/m)
+        "layout": "paper",                # "paper": ends fixed to the chassis; "closed": a loop (closed.py)
+        "tension": 80000.0,               # closed layout: static tension the derived link count and preload aim at (N)
+    }
+
+
+def closed_defaults():
+    """Sprocket, idler, rollers and drive of the closed layout (model/closed.py derives the
+    values given as 0 from the paper's vehicle; docs/model.md lists them)."""
+    return {
+        "sprocket": {
+            "position": "rear",           # where the paper's track end is: "rear" or "front"; the idler at the other
+            "teeth": 10,
+            "pitch_radius": 0.0,          # seated pin centres (m); 0: p / (2 sin(pi/N)), p the link under `tension`
+            "seat_radius": 0.03,          # circular seat between two teeth (m)
+            "pin_radius": 0.027,          # a pin where it meets the teeth (m)
+            "tip_radius": 0.0,            # tooth tips (m); 0: seat centres + 0.4 seat_radius
+            "stiffness": 1.0e8,           # pin-tooth penalty stiffness (N/m; the paper's pad stiffness)
+            "inertia": 5.0,               # about its axis, drive line included (kg m^2)
+        },
+        "idler": {
+            "radius": 0.28,               # the road wheels' (m)
+            "mass": 150.0,                # wheel + carrier (kg)
+            "preload": 0.0,               # tensioner force at slide 0 (N); 0: holds the loop at track.tension
+            "stiffness": 1.0e6,           # tensioner spring (N/m; Chrono's M113)
+            "damping": 1.4e4,             # tensioner damper (N s/m; Chrono's M113)
+            "travel": 0.15,               # the carrier slides at most this far either way (m)
+            "guide_angle": 0.0,           # the guide's tilt above the outward horizontal (deg)
+        },
+        "rollers": {
+            "positions": [],              # body points of the support rollers' axes, [[x, y], ...] (m)
+            "radius": 0.15,               # (m)
+        },
+        "drive": {
+            "kind": "none",               # "none" (free sprocket), "torque", "speed"
+            "torque": 0.0,                # torque drive: forward torque on the sprocket (N m)
+            "curve": [],                  # torque drive: [[sprocket speed rad/s, torque N m], ...] instead of torque
+            "target": 10.0,               # speed drive: chassis speed to hold (m/s)
+            "gain_p": 3.0e4,              # speed drive: PI gains (N m per m/s, N m per m)
+            "gain_i": 3.0e4,
+            "torque_limit": 3.0e4,        # speed drive: |torque| at most (N m)
+        },
     }
 
 

@@ -1,7 +1,9 @@
 """The drive sprocket's tooth profile and its contact with the track pins (closed layout).
 
 The profile is a disc of the tip radius with N circular seats cut into its rim: seat k is
-a circle of radius r_g centred on the pitch circle (radius r_p) at angle angle + 2 pi k / N;
+a circle of radius r_g centred at angle angle + 2 pi k / N, at r_p + (r_g - r_pin) from
+the axis, so that a pin seated at the bottom of a seat has its centre on the pitch circle
+(radius r_p: the circle the track's pins wrap around);
 the tips are the arcs of the tip circle between seats, and each seat meets the tip circle
 at two corners. A pin is a circle of radius r_pin; its penetration into the profile is
 r_pin minus the distance of its centre from the profile's solid, found on the nearest seat
@@ -19,10 +21,16 @@ from .layout import (LP_PIN_RADIUS, LP_PITCH_RADIUS, LP_SEAT_RADIUS, LP_TEETH, L
 
 
 @njit(**INLINE)
+def seat_centre_radius(pitch_radius, seat_radius, pin_radius):
+    """Distance of the seat centres from the axis: a seated pin's centre on the pitch circle."""
+    return pitch_radius + seat_radius - pin_radius
+
+
+@njit(**INLINE)
 def _corner(dx, dy, r, ux, uy, rp, rg, rt):
-    """The nearer of the two corners of the seat in direction (ux, uy) (where its circle
-    meets the tip circle) to the point (dx, dy), all relative to the axis: (distance, its
-    unit direction towards the point)."""
+    """The nearer of the two corners of the seat in direction (ux, uy) (where its circle,
+    centred rp from the axis, meets the tip circle) to the point (dx, dy), all relative to
+    the axis: (distance, its unit direction towards the point)."""
     a = (rp * rp + rt * rt - rg * rg) / (2.0 * rp)      # along u
     b = math.sqrt(max(rt * rt - a * a, 0.0))           # across u
     best = math.inf
@@ -46,10 +54,10 @@ def pin_on_sprocket(dx, dy, angle, lp):
     profile (contact where > 0), (nx, ny) the unit direction that pushes the pin out of
     it; inside is True where the pin's centre lies inside a tooth (it went through)."""
     n = lp[LP_TEETH]
-    rp = lp[LP_PITCH_RADIUS]
     rg = lp[LP_SEAT_RADIUS]
     rt = lp[LP_TIP_RADIUS]
     rpin = lp[LP_PIN_RADIUS]
+    rp = seat_centre_radius(lp[LP_PITCH_RADIUS], rg, rpin)
     r = math.sqrt(dx * dx + dy * dy)
     if r >= rt + rpin or r == 0.0:
         return -1.0, 0.0, 0.0, False
@@ -86,9 +94,11 @@ def pitch_radius(link_pitch, teeth):
     return link_pitch / (2.0 * math.sin(math.pi / teeth))
 
 
-def profile(teeth, rp, rg, rt, angle=0.0, per_arc=12):
+def profile(teeth, pitch_radius, seat_radius, tip_radius, pin_radius, angle=0.0, per_arc=12):
     """The tooth profile as a closed polyline (n, 2) about the axis, for drawing."""
     import numpy as np
+    rg, rt = seat_radius, tip_radius
+    rp = pitch_radius + seat_radius - pin_radius
     pitch = 2.0 * math.pi / teeth
     a = (rp * rp + rt * rt - rg * rg) / (2.0 * rp)
     half_tip = math.atan2(math.sqrt(max(rt * rt - a * a, 0.0)), a)     # seat corner, seen from the axis
