@@ -23,14 +23,28 @@ def _var(dims, data, units, long_name, **attrs):
 T, WH, P, K = ("time",), ("time", "wheel"), ("time", "pin"), ("time", "link")
 
 
+def _place(model, q):
+    """Pins, road wheels (and the closed layout's idler and rollers) of every sample."""
+    n, nw, nl = q.shape[0], model.nw, model.n_links
+    wheels = np.empty((n, nw, 2))
+    q = np.ascontiguousarray(q)
+    if model.closed:
+        from .model.loop import place_loop_samples
+        pins = np.empty((n, nl, 2))
+        guides = np.empty((n, model.arrays.guides.shape[0], 2))
+        place_loop_samples(q, model.arrays, pins, wheels, guides)
+        return pins, wheels, guides
+    pins = np.empty((n, nl + 1, 2))
+    place_samples(q, model.par, model.arms, model.ends, pins, wheels)
+    return pins, wheels, None
+
+
 def _motion(model, result):
     """Chassis, arms, wheels and pins, placed by the kernels' own kinematics."""
     nw, nl, n = model.nw, model.n_links, len(result.time)
-    nq = L.n_coordinates(nw, nl)
+    nq = model.nq
     q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
-    pins = np.empty((n, nl + 1, 2))
-    wheels = np.empty((n, nw, 2))
-    place_samples(np.ascontiguousarray(q), model.par, model.arms, model.ends, pins, wheels)
+    pins, wheels, _ = _place(model, q)
     wheel_f = d[:, L.D_WHEEL:L.D_WHEEL + 2 * nw].reshape(n, nw, 2)
     return {
         "chassis_x": _var(T, q[:, L.Q_X], "m", "chassis mass-centre x"),
@@ -49,7 +63,7 @@ def _motion(model, result):
         "ground_force_x": _var(T, d[:, L.D_GROUND_FX], "N", "total horizontal ground force on the track"),
         "ground_force_y": _var(T, d[:, L.D_GROUND_FY], "N", "total vertical ground force on the track"),
         "obstacle_force": _var(T, d[:, L.D_CORNER_FORCE], "N", "sum of the ground-corner contact forces"),
-        "pin_x": _var(P, pins[:, :, 0], "m", "track pin x (pins 0 and last fixed to the chassis)"),
+        "pin_x": _var(P, pins[:, :, 0], "m", "track pin x (paper's layout: pins 0 and last fixed to the chassis)"),
         "pin_y": _var(P, pins[:, :, 1], "m", "track pin y"),
         "link_tension": _var(K, d[:, L.diag_tension(nw):L.diag_tension(nw) + nl], "N",
                              "link tension, Eq. (8) (with the link dashpot if any); negative is compression"),
@@ -101,6 +115,73 @@ _FIRST_TIMES = [  # name, peaks row, text
     ("first_compression_time", L.PK_FIRST_COMPRESSION, "first time a link goes into compression (linear between "
      "steps) (after it the motion is sensitive, see results_schema.md)"),
 ]
+
+
+def _span_tensions(model, q, pins, tension, g):
+    """Tension of the link that leaves the sprocket upwards and of the one that leaves it
+    downwards (the first link with one pin seated on the sprocket and the other off it)."""
+    c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
+    sx, sy = g.sprocket
+    ax = q[:, L.Q_X] + c * sx - s * sy
+    ay = q[:, L.Q_Y] + s * sx + c * sy
+    r = np.hypot(pins[:, :, 0] - ax[:, None], pins[:, :, 1] - ay[:, None])
+    seated = r < g.pitch_radius + 0.5 * (model.arrays.loop[L.LP_SEAT_RADIUS] - model.arrays.loop[L.LP_PIN_RADIUS]) + 1e-3
+    # link b joins pins b and b+1 (pins numbered 1..n: link 0 joins pin n and pin 1)
+    a_seat = np.roll(seated, 1, axis=1)     # pin b (link b's first pin), column b - 1 of pins
+    b_seat = seated                         # pin b + 1
+    leaving = a_seat != b_seat
+    mid_y = 0.5 * (pins[:, :, 1] + np.roll(pins[:, :, 1], 1, axis=1))
+    out = np.full((len(q), 2), np.nan)
+    for k in range(len(q)):
+        idx = np.flatnonzero(leaving[k])
+        if idx.size >= 2:
+            up, down = idx[np.argmax(mid_y[k, idx])], idx[np.argmin(mid_y[k, idx])]
+            out[k] = tension[k, up], tension[k, down]
+    return out
+
+
+def _closed_layout(model, result, scenario):
+    """The closed layout's own variables: sprocket, idler, drive, span tensions."""
+    from .simulate import closed_parts
+    g = closed_parts(scenario)[0]
+    nw, nl, nq = model.nw, model.n_links, model.nq
+    q, qd, d, y = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag, result.y
+    i_s, i_i = L.q_sprocket(nw, nl), L.q_idler(nw, nl)
+    pins, _, guides = _place(model, q)
+    tension = d[:, L.diag_tension(nw):L.diag_tension(nw) + nl]
+    pk = result.peaks
+    v = {
+        "sprocket_angle": _var(T, -q[:, i_s], "rad", "sprocket angle relative to the chassis, forward (clockwise) positive"),
+        "sprocket_speed": _var(T, -qd[:, i_s], "rad s-1", "sprocket speed relative to the chassis, forward positive"),
+        "sprocket_torque": _var(T, d[:, L.D_DRIVE_TORQUE], "N m", "drive torque on the sprocket, forward positive"),
+        "teeth_torque": _var(T, d[:, L.D_TEETH_TORQUE], "N m",
+                             "torque of the track pins on the sprocket teeth about its axis, forward positive"),
+        "idler_position": _var(T, q[:, i_i], "m", "idler carrier's slide along its guide from its middle, outward "
+                               "positive"),
+        "idler_force": _var(T, d[:, L.D_IDLER_FORCE], "N", "tensioner force on the idler carrier along its guide, "
+                            "outward positive"),
+        "idler_x": _var(T, guides[:, 0, 0], "m", "idler centre x"),
+        "idler_y": _var(T, guides[:, 0, 1], "m", "idler centre y"),
+        "drive_work": _var(T, y[:, 2 * nq + L.Y_DRIVE_WORK], "J", "work done by the drive on the sprocket since t = 0"),
+        "span_tension": _var(("time", "span"), _span_tensions(model, q, pins, tension, g), "N",
+                             "tension of the link leaving the sprocket: upper span, lower span"),
+        "peak_sprocket_torque": _var((), pk[L.PK_DRIVE_TORQUE, 0], "N m", "max drive torque over all accepted steps"),
+        "peak_sprocket_torque_time": _var((), pk[L.PK_DRIVE_TORQUE, 1], "s", "time of peak_sprocket_torque"),
+        "peak_idler_force": _var((), pk[L.PK_IDLER_FORCE, 0], "N", "max tensioner force over all accepted steps"),
+        "peak_idler_force_time": _var((), pk[L.PK_IDLER_FORCE, 1], "s", "time of peak_idler_force"),
+    }
+    return v
+
+
+def _closed_attrs(scenario):
+    from .simulate import closed_parts
+    g, lp, guides = closed_parts(scenario)
+    return {"track_layout": "closed", "closed_layout": json.dumps({
+        "sprocket": g.sprocket.tolist(), "teeth": int(lp[L.LP_TEETH]), "pitch_radius": g.pitch_radius,
+        "seat_radius": lp[L.LP_SEAT_RADIUS], "pin_radius": lp[L.LP_PIN_RADIUS], "tip_radius": g.tip_radius,
+        "idler": g.idler.tolist(), "guide": g.guide.tolist(), "travel": lp[L.LP_TRAVEL],
+        "idler_radius": scenario["idler.radius"], "rollers": guides[1:, :2].tolist(),
+        "roller_radius": scenario["rollers.radius"]})}
 
 
 def _peaks(pk, nw, e0):
@@ -158,8 +239,10 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     result.extra as (dims, data, units, long_name)."""
     nw, nl = model.nw, model.n_links
     v = _motion(model, result)
-    v.update(_energies(result, L.n_coordinates(nw, nl)))
+    v.update(_energies(result, model.nq))
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
+    if model.closed:
+        v.update(_closed_layout(model, result, scenario))
     for name, (dims, data, units, text) in result.extra.items():
         v[name] = _var(dims, data, units, text)
     coords = {
@@ -169,6 +252,13 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         "link": _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1)"),
     }
     attrs = _attrs(scenario, model, eq, ground, resolved, result.stats, wall_time, solve_time)
+    if model.closed:
+        coords["pin"] = _var(("pin",), np.arange(1, nl + 1), "1", "track pin number, clockwise from the front "
+                             "of the ground run")
+        coords["link"] = _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1; link 0 "
+                              "joins the last pin and pin 1)")
+        coords["span"] = _var(("span",), np.array(["upper", "lower"]), "1", "the spans leaving the sprocket")
+        attrs.update(_closed_attrs(scenario))
     return xr.Dataset(v, coords=coords, attrs=attrs)
 
 

@@ -264,8 +264,11 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_
 
 
 class _LoopProblem(_Problem):
-    """The closed layout at rest: unknowns u = (y_c, pitch, idler slide, every pin), the
-    arms at the equilibrium angle, the sprocket held at the angle that seats the pins."""
+    """The closed layout at rest: unknowns u = (y_c, pitch, idler slide, sprocket angle,
+    every pin), the arms at the equilibrium angle, the sprocket held by the drive at the
+    angle that seats the pins (free = 1 would let it turn to where the teeth's torque
+    vanishes; Newton's method does not find that point reliably: the loop's cogging
+    energy is not smooth)."""
 
     def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides):
         from .closed import loop_pins
@@ -281,6 +284,7 @@ class _LoopProblem(_Problem):
         self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
         self.pins, self.psi = loop_pins(geometry)
         self.slide0 = geometry.slide
+        self.free = 0   # the spec's equilibrium: the sprocket held by the drive (a free one: docs/model.md)
         self.weight = (total_mass(vehicle, track) + track["pin_mass"] + loop[L.LP_IDLER_MASS]) * gravity
 
     def q_of(self, u):
@@ -289,12 +293,12 @@ class _LoopProblem(_Problem):
         q[L.Q_PITCH] = u[1]
         q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
         q[L.q_idler(self.nw, self.n_links)] = u[2]
-        q[L.q_sprocket(self.nw, self.n_links)] = self.psi
-        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[3:]
+        q[L.q_sprocket(self.nw, self.n_links)] = u[3]
+        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[4:]
         return q
 
     def _args(self):
-        return self.phi, self.psi, self.m, self.work, self.diag
+        return self.phi, self.psi, self.free, self.m, self.work, self.diag
 
     def residual(self, u):
         r = np.empty(u.size)
@@ -318,9 +322,10 @@ class _LoopProblem(_Problem):
 
 
 @njit(**KERNEL)
-def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
+def _loop_residual(u, phi, psi, free, m, w, diag, r, arm_moment):
     """The closed layout's generalised forces at rest (loop.loop_rhs fills w.genf) on the
-    unknowns into r, each arm's moment about its pivot; returns the horizontal force."""
+    unknowns into r (on the sprocket angle: its torque if it turns freely, else the angle's
+    change, which holds it), each arm's moment about its pivot; returns the horizontal force."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
     nq = w.genf.shape[0]
@@ -330,17 +335,18 @@ def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
     for i in range(nw):
         y[L.Q_ARM + i] = phi
     y[q_idler(nw, n)] = u[2]
-    y[q_sprocket(nw, n)] = psi
+    y[q_sprocket(nw, n)] = u[3]
     off = pin_offset(nw)
     for k in range(2 * n):
-        y[off + k] = u[3 + k]
+        y[off + k] = u[4 + k]
     ydot = np.empty(y.shape[0])
     loop_rhs(y, m, w, ydot, diag)
     r[0] = w.genf[L.Q_Y]
     r[1] = w.genf[L.Q_PITCH]
     r[2] = w.genf[q_idler(nw, n)]
+    r[3] = w.genf[q_sprocket(nw, n)] if free else u[3] - psi
     for k in range(2 * n):
-        r[3 + k] = w.genf[off + k]
+        r[4 + k] = w.genf[off + k]
     for i in range(nw):
         arm_moment[i] = w.genf[L.Q_ARM + i]
     return w.genf[L.Q_X]
@@ -353,7 +359,7 @@ def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, gui
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
     wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
     yc = -wcb[:, 1].min() + rho + P.par[L.P_PAD_GROUND]
-    u = np.concatenate([[yc, 0.0, P.slide0], (P.pins + [0.0, yc]).ravel()])
+    u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
     u, norm, it = _continuation(P, u, tol_rel * P.weight, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
         raise EquilibriumError(

@@ -309,7 +309,9 @@ PK_FIRST_CORNER = 8      # value 1 once a ground corner touched the track; time 
 PK_FIRST_COMPRESSION = 9  # value 1 once any link went into compression; time of first
 PK_SWITCH = 10           # time (column 1) of the last step ended at a located contact switch
 PK_FIRST_OBSTACLE = 11   # value 1 once any part of an obstacle (face, corner, top) touched the track; time
-PK_WHEEL_FY = 12         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
+PK_DRIVE_TORQUE = 12     # max drive torque on the sprocket (closed layout)
+PK_IDLER_FORCE = 13      # max tensioner force
+PK_WHEEL_FY = 14         # max vertical contact force on wheel i: row PK_WHEEL_FY + i
 
 
 def n_peaks(n_wheels):

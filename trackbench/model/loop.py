@@ -17,17 +17,16 @@ the pin-tooth contacts and of every contact of the paper's kernels go into dW/dt
 work-based energy residual stays a check of the integration.
 """
 
-import math
-
+import numpy as np
 from numba import njit
 
 from ..status import IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET, WHEEL_THROUGH_TRACK
-from .bundles import ARM_BT, ARM_BX, ARM_BY, ARM_D, ARM_Q, LOOP_IDLER, LOOP_SPROCKET
+from .bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COLS, ARM_D, ARM_Q, LOOP_IDLER, LOOP_SPROCKET
 from .contact_force import normal_force
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from .drive import drive_torque
 from .index import diag_tension, nq_of, q_idler, q_pin, q_sprocket
-from .jit import BORROW, INLINE
+from .jit import BORROW, INLINE, KERNEL
 from .kernels import _probe_on_track, contact_law, ground_contacts, link_tensions, refresh_neighbours, wheel_contacts
 from .kinematics import body_offset, place_wheels, wheel_velocities
 from .layout import (
@@ -36,7 +35,7 @@ from .layout import (
     K_GUIDE_LINK, K_GUIDE_PIN, LP_TRAVEL, P_C_WHEEL, P_CONTACT_GEOMETRY, LP_GUIDE_X, LP_GUIDE_Y, LP_IDLER_MASS, LP_PRELOAD, LP_SPROCKET_INERTIA,
     LP_SPROCKET_X, LP_SPROCKET_Y, LP_TENSIONER_DAMPING, LP_TENSIONER_STIFFNESS, LP_TOOTH_DAMPING,
     LP_TOOTH_STIFFNESS, P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CONTACT_EXPONENT, P_CONTACT_LAW,
-    P_CONTACT_DAMPING, P_DAMPING_RAMP, P_GRAVITY, P_MIN_APPROACH, P_PIN_MASS, P_CHASSIS_MASS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+    P_DAMPING_RAMP, P_GRAVITY, P_MIN_APPROACH, P_PIN_MASS, P_CHASSIS_MASS, Q_ARM, Q_PITCH, Q_X, Q_Y,
     SP_ANGLE, SP_FX, SP_FY, SP_RATE, SP_TORQUE, SP_VX, SP_VY, SP_X, SP_Y, Y_DISSIPATED, Y_DRIVE_INTEGRAL,
     Y_DRIVE_WORK, Y_WORK,
 )
@@ -341,3 +340,16 @@ def loop_rhs(y, m, w, ydot, diag):
     diag[D_DRIVE_TORQUE] = tau
     diag[D_IDLER_FORCE] = tension_force
     diag[D_TEETH_TORQUE] = -w.spr[SP_TORQUE]
+
+
+@njit(**KERNEL)
+def place_loop_samples(qs, m, pins, wheels, guides):
+    """place_loop for every row of qs (output samples): pins (n, n_links, 2) (rows 1..n_links),
+    wheels (n, n_wheels, 2), idler and rollers (n, n_guides, 2)."""
+    apos = np.empty((pins.shape[1] + 1, 2))
+    arm = np.empty((m.arms.shape[0], ARM_COLS))
+    for k in range(qs.shape[0]):
+        place_loop(qs[k], m, apos, wheels[k], arm, guides[k])
+        for b in range(pins.shape[1]):
+            pins[k, b, 0] = apos[b + 1, 0]
+            pins[k, b, 1] = apos[b + 1, 1]
