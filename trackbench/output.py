@@ -179,6 +179,7 @@ def _closed_attrs(scenario):
     return {"track_layout": "closed", "closed_layout": json.dumps({
         "sprocket": g.sprocket.tolist(), "teeth": int(lp[L.LP_TEETH]), "pitch_radius": g.pitch_radius,
         "seat_radius": lp[L.LP_SEAT_RADIUS], "pin_radius": lp[L.LP_PIN_RADIUS], "tip_radius": g.tip_radius,
+        "flank_angle": scenario["sprocket.flank_angle"],
         "idler": g.idler.tolist(), "guide": g.guide.tolist(), "travel": lp[L.LP_TRAVEL],
         "idler_radius": scenario["idler.radius"], "rollers": guides[1:, :2].tolist(),
         "roller_radius": scenario["rollers.radius"]})}

@@ -114,6 +114,7 @@ RULES = {
     "sprocket.seat_radius": _POS,
     "sprocket.pin_radius": _POS,
     "sprocket.tip_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived)"),
+    "sprocket.flank_angle": (float, 0.0, 45.0, "a number in [0, 45] deg"),
     "sprocket.stiffness": _POS,
     "sprocket.inertia": _POS,
     "idler.radius": _POS,

@@ -81,6 +81,9 @@ def _loop_velocities(scenario, eq, y0):
     y0[nq + off:nq + off + 2 * n] = (rel + [v, 0.0]).ravel()
     g = closed_parts(scenario)[0]
     y0[nq + L.q_sprocket(nw, n)] = -v / g.pitch_radius
+    if scenario["drive.kind"] == "speed" and scenario["drive.gain_i"] > 0.0:
+        # the controller starts with the torque that held the sprocket in the equilibrium
+        y0[2 * nq + L.Y_DRIVE_INTEGRAL] = eq.info["holding_torque"] / scenario["drive.gain_i"]
 
 
 def initial_state(scenario: Scenario, eq):

@@ -7,7 +7,8 @@ taut loop around the road wheels (radius + pad h_w), the idler (radius + h_w), t
 (radius + h_w) and the sprocket's pitch circle. Derived where not given:
 
 - link pitch under the static tension T (``track.tension``): p = L0 + T / k_tau (Eq. 8);
-- sprocket pitch radius r_p = p / (2 sin(pi / N)), tip radius = seat centres + 0.4 r_g;
+- sprocket pitch radius r_p = p / (2 sin(pi / N)), tip radius r_p + r_pin (the teeth as
+  high as a seated pin);
 - link count: the loop's length at slide 0 over p, rounded;
 - the idler's slide s0 where the loop is n_links x p long, and the preload that holds the
   loop at T there: T (cos a1 + cos a2) + k_t s0, a1, a2 the angles of the two spans that
@@ -26,7 +27,6 @@ from .track_path import closed_loop, closed_track, link_count
 
 TOOTH_PITCH_TOLERANCE = 0.02   # the sprocket's tooth pitch within 2 % of the link pitch under tension
 SEARCH_SAMPLES = 256           # points per circle of the loops the slide search measures
-TIP_HEIGHT = 0.4               # tip radius = seat centres + TIP_HEIGHT x seat radius (the default)
 
 
 class ClosedLayoutError(ValueError):
@@ -45,6 +45,8 @@ class ClosedGeometry:
     idler: np.ndarray          # body point of the idler centre at slide 0
     guide: np.ndarray          # unit direction of the guide (body frame)
     span_angles: tuple         # angles of the spans leaving the idler to its guide (rad)
+    teeth: int
+    pin_radius: float
     circles: list              # (x, y, radius) of the loop's centre line around every wheel, at the slide
 
     def resolved(self):
@@ -148,10 +150,10 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
     if 2.0 * rg >= 2.0 * rs * math.sin(math.pi / n_teeth):
         raise ClosedLayoutError(f"sprocket.seat_radius = {rg} m leaves no teeth between {n_teeth} seats; allowed: "
                                 f"below {rs * math.sin(math.pi / n_teeth):.4g} m")
-    tip = spr["tip_radius"] or rs + TIP_HEIGHT * rg
-    if not rs < tip < rs + rg:
-        raise ClosedLayoutError(f"sprocket.tip_radius = {tip:.4g} m must lie between the seat centres ({rs:.4g} m) "
-                                f"and the seats' outer edge ({rs + rg:.4g} m)")
+    tip = spr["tip_radius"] or rp + rpin
+    if not math.hypot(rs, rg) < tip < rp + 3.0 * rpin:
+        raise ClosedLayoutError(f"sprocket.tip_radius = {tip:.4g} m must lie between {math.hypot(rs, rg):.4g} m (the "
+                                f"seats' rims) and {rp + 3.0 * rpin:.4g} m (pitch radius + 3 pin radii)")
     sprocket, idler = _ends(v, spr)
     guide = _guide(idl, 1.0 if idler[0] > sprocket[0] else -1.0)
     travel = idl["travel"]
@@ -174,8 +176,9 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
     reach_i = math.hypot(idl["radius"] + tr["pad_wheel"], 0.5 * tr["link_length"])
     a1, a2 = _span_angles(hull, idler + slide * guide, reach_i, guide)
     preload = idl["preload"] or tr["tension"] * (math.cos(a1) + math.cos(a2)) + idl["stiffness"] * slide
-    _check_rollers(tr, rol, hull)
-    return ClosedGeometry(n, pitch, rp, tip, preload, slide, sprocket, idler, guide, (a1, a2), circles)
+    _check_rollers(tr, rol, circles)
+    return ClosedGeometry(n, pitch, rp, tip, preload, slide, sprocket, idler, guide, (a1, a2), n_teeth, rpin,
+                          circles)
 
 
 def loop_pins(g):
@@ -183,17 +186,33 @@ def loop_pins(g):
     ground, as the paper's track), and the sprocket angle that seats one of them."""
     pins, _ = closed_track(g.circles, g.n_links)
     pins = pins[::-1].copy()
-    r = np.hypot(*(pins - g.sprocket).T)
+    d = pins - g.sprocket
+    r = np.hypot(*d.T)
     b = int(np.argmin(np.abs(r - g.pitch_radius) + 1e-3 * np.abs(pins[:, 0] - g.sprocket[0])))
-    return pins, math.atan2(pins[b, 1] - g.sprocket[1], pins[b, 0] - g.sprocket[0])
+    angle = math.atan2(d[b, 1], d[b, 0])
+    # every pin near the teeth into its seat: the taut loop leaves the pitch circle along
+    # its tangents, which would put the next pins on the teeth's flanks
+    pitch = 2.0 * math.pi / g.teeth
+    near = r < g.tip_radius + g.pin_radius
+    k = np.round((np.arctan2(d[near, 1], d[near, 0]) - angle) / pitch)
+    seat = angle + k * pitch
+    pins[near] = g.sprocket + g.pitch_radius * np.column_stack([np.cos(seat), np.sin(seat)])
+    return pins, angle
 
 
-def _check_rollers(tr, rol, hull):
+def _check_rollers(tr, rol, circles):
+    """Each support roller must touch the loop that sprocket, road wheels and idler span."""
+    n_rollers = len(rol["positions"])
+    hull, _ = closed_loop(circles[:len(circles) - n_rollers], SEARCH_SAMPLES)
+    a, d = hull[:-1], np.diff(hull, axis=0)
     for j, (x, y) in enumerate(rol["positions"]):
-        d = np.hypot(hull[:, 0] - x, hull[:, 1] - y).min()
-        if d > rol["radius"] + tr["pad_wheel"] + 2.0 * tr["link_length"]:
-            raise ClosedLayoutError(f"rollers.positions[{j}] = [{x}, {y}] is {d:.3g} m from the track: a support "
-                                    "roller must touch the return run (move it, or leave it out)")
+        p = np.array([x, y])
+        t = np.clip(((p - a) * d).sum(1) / (d * d).sum(1), 0.0, 1.0)
+        gap = np.hypot(*(a + t[:, None] * d - p).T).min() - (rol["radius"] + tr["pad_wheel"])
+        if abs(gap) > tr["link_length"]:
+            raise ClosedLayoutError(f"rollers.positions[{j}] = [{x}, {y}] puts the roller {gap:+.3g} m from the track "
+                                    "(+ outside, - inside the loop): a support roller must touch the return run "
+                                    f"(within track.link_length = {tr['link_length']} m)")
 
 
 def loop_vector(g, spr, idl, drive, contact_c):
@@ -208,6 +227,7 @@ def loop_vector(g, spr, idl, drive, contact_c):
     lp[L.LP_SEAT_RADIUS] = spr["seat_radius"]
     lp[L.LP_TIP_RADIUS] = g.tip_radius
     lp[L.LP_PIN_RADIUS] = spr["pin_radius"]
+    lp[L.LP_FLANK_ANGLE] = math.radians(spr["flank_angle"])
     lp[L.LP_TOOTH_STIFFNESS] = spr["stiffness"]
     lp[L.LP_TOOTH_DAMPING] = contact_c
     lp[L.LP_GUIDE_X], lp[L.LP_GUIDE_Y] = g.guide

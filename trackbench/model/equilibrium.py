@@ -206,6 +206,32 @@ def _newton(P, u, target, max_iter):
     return u, norm, it
 
 
+def _levenberg_marquardt(P, u, target, max_iter):
+    """Where Newton's method stalls at a contact that opens or closes under its step:
+    Levenberg-Marquardt steps on the sum of squared residuals (the damping grows until a
+    step lowers it); returns (u, max residual, iterations)."""
+    r, _, _ = P.residual(u)
+    it = 0
+    lam = 1e-3
+    while np.abs(r).max() > target and it < max_iter:
+        it += 1
+        J = P.jacobian(u)
+        A = J.T @ J
+        g = J.T @ r
+        d = np.diag(A).copy() + 1e-30
+        for _ in range(30):
+            du = np.linalg.solve(A + lam * np.diag(d), -g)
+            rn, _, _ = P.residual(u + du)
+            if rn @ rn < r @ r:
+                u, r = u + du, rn
+                lam = max(lam / 5.0, 1e-9)
+                break
+            lam *= 4.0
+        else:
+            break
+    return u, np.abs(r).max(), it
+
+
 def _continuation(P, u, target, max_iter, step=0.05):
     """Newton's method, for a power law F = k delta^n (no stiffness at zero compression,
     where Newton's method starts) through a chain of laws k d^(n - m) delta^m, m from 1 to
@@ -307,18 +333,28 @@ class _LoopProblem(_Problem):
         return r, fx, arm_moment
 
     def jacobian(self, u, h=1e-7):
-        args = self._args()
-        rp, rm, am = np.empty(u.size), np.empty(u.size), np.empty(self.nw)
         J = np.empty((u.size, u.size))
-        up = u.copy()
-        for k in range(u.size):
-            up[k] = u[k] + h
-            _loop_residual(up, *args, rp, am)
-            up[k] = u[k] - h
-            _loop_residual(up, *args, rm, am)
-            up[k] = u[k]
-            J[:, k] = (rp - rm) / (2.0 * h)
+        _loop_jacobian(u, h, *self._args(), J)
         return J
+
+
+@njit(**KERNEL)
+def _loop_jacobian(u, h, phi, psi, free, m, w, diag, J):
+    """Central finite differences of _loop_residual (compiled: ~270 residuals a step)."""
+    n = u.shape[0]
+    rp = np.empty(n)
+    rm = np.empty(n)
+    am = np.empty(m.arms.shape[0])
+    up = u.copy()
+    for k in range(n):
+        up[k] = u[k] + h
+        _loop_residual(up, phi, psi, free, m, w, diag, rp, am)
+        up[k] = u[k] - h
+        _loop_residual(up, phi, psi, free, m, w, diag, rm, am)
+        up[k] = u[k]
+        for i in range(n):
+            v = (rp[i] - rm[i]) / (2.0 * h)
+            J[i, k] = v if abs(v) > 1e-200 else 0.0   # no subnormals: LAPACK slows down 50x on them
 
 
 @njit(**KERNEL)
@@ -356,11 +392,17 @@ def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, gui
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
     taut loop (model/closed.py) resting on the ground, the sprocket held."""
     P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides)
-    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
-    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
-    yc = -wcb[:, 1].min() + rho + P.par[L.P_PAD_GROUND]
+    yc = -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND]     # the loop's lowest pins resting on the ground
     u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
-    u, norm, it = _continuation(P, u, tol_rel * P.weight, max_iter)
+    target = tol_rel * P.weight
+    u, norm, it = _continuation(P, u, target, max_iter)
+    for _ in range(4):           # a stall at an opening contact: round it by LM, then Newton again
+        if norm <= target:
+            break
+        u, norm, k = _levenberg_marquardt(P, u, target, 20)
+        it += k
+        u, norm, k = _newton(P, u, target, max_iter)
+        it += k
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
         raise EquilibriumError(
             f"static equilibrium of the closed track not found: force residual {norm:.3g} N after {it} Newton "
@@ -377,5 +419,5 @@ def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, gui
         ground_force=float(P.diag[L.D_GROUND_FY]), weight=P.weight,
         residual=float(max(np.abs(r).max(), abs(fx))), iterations=it,
         info={"pins": apos[1:].copy(), "wheel_centres": wc.copy(), "idler_slide": float(u[2]),
-              "idler_force": float(P.diag[L.D_IDLER_FORCE]), "holding_torque": float(-w.spr[L.SP_TORQUE]),
+              "idler_force": float(P.diag[L.D_IDLER_FORCE]), "holding_torque": float(w.spr[L.SP_TORQUE]),   # forward drive torque that holds the sprocket
               "guide_forces": w.fguide.copy()})

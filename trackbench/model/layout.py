@@ -196,7 +196,8 @@ LP_GAIN_P = 19           # PI gains of the speed drive (N m per m/s, N m per m)
 LP_GAIN_I = 20
 LP_TORQUE_LIMIT = 21     # |torque| of the speed drive at most this (N m)
 LP_TRAVEL = 22           # the idler's slide stays within +-travel (m)
-LP_CURVE = 23            # torque-speed curve: LP_CURVE_POINTS pairs (sprocket speed rad/s, torque N m) after it
+LP_FLANK_ANGLE = 23      # flare of the teeth's flanks, the pressure angle (rad)
+LP_CURVE = 24            # torque-speed curve: LP_CURVE_POINTS pairs (sprocket speed rad/s, torque N m) after it
 LP_CURVE_POINTS = 16
 N_LOOP = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # [LP_CURVE] holds the number of points used
 

@@ -61,7 +61,8 @@ def closed_defaults():
             "pitch_radius": 0.0,          # seated pin centres (m); 0: p / (2 sin(pi/N)), p the link under `tension`
             "seat_radius": 0.03,          # circular seat between two teeth (m)
             "pin_radius": 0.027,          # a pin where it meets the teeth (m)
-            "tip_radius": 0.0,            # tooth tips (m); 0: seat centres + 0.4 seat_radius
+            "tip_radius": 0.0,            # tooth tips (m); 0: pitch_radius + pin_radius
+            "flank_angle": 15.0,          # the flanks' flare, the pressure angle (deg)
             "stiffness": 1.0e8,           # pin-tooth penalty stiffness (N/m; the paper's pad stiffness)
             "inertia": 5.0,               # about its axis, drive line included (kg m^2)
         },

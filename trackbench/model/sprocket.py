@@ -1,15 +1,15 @@
 """The drive sprocket's tooth profile and its contact with the track pins (closed layout).
 
-The profile is a disc of the tip radius with N circular seats cut into its rim: seat k is
-a circle of radius r_g centred at angle angle + 2 pi k / N, at r_p + (r_g - r_pin) from
-the axis, so that a pin seated at the bottom of a seat has its centre on the pitch circle
-(radius r_p: the circle the track's pins wrap around);
-the tips are the arcs of the tip circle between seats, and each seat meets the tip circle
-at two corners. A pin is a circle of radius r_pin; its penetration into the profile is
-r_pin minus the distance of its centre from the profile's solid, found on the nearest seat
-(the seat wall, or a corner where the wall's nearest point lies beyond the tip circle) or
-the tip arc. That distance is continuous in the pin's position, so the contact energy is
-continuous wherever the pin goes (the same property as the continuous track geometry).
+Each gap between two teeth is a seat and two flanks: the seat is the inner half of a
+circle of radius r_g centred at r_s = r_p + (r_g - r_pin) from the axis (so a pin seated
+at its bottom has its centre on the pitch circle r_p, the circle the track's pins wrap);
+from the ends of that half circle the flanks run outwards, flaring by the flank angle
+alpha (the pressure angle: a flank pushes a loaded pin out by F tan alpha, which the
+track's tension holds in), up to the tip circle; the teeth's tops are arcs of the tip
+circle. A pin is a circle of radius r_pin; its penetration is r_pin minus the distance of
+its centre to the profile (seat arc, flank, tip arc or a tip corner of the nearest gap).
+That distance is continuous in the pin's position, so the contact energy is continuous
+wherever the pin goes (as the continuous track geometry's).
 """
 
 import math
@@ -17,7 +17,7 @@ import math
 from numba import njit
 
 from .jit import INLINE
-from .layout import (LP_PIN_RADIUS, LP_PITCH_RADIUS, LP_SEAT_RADIUS, LP_TEETH, LP_TIP_RADIUS)
+from .layout import LP_FLANK_ANGLE, LP_PIN_RADIUS, LP_PITCH_RADIUS, LP_SEAT_RADIUS, LP_TEETH, LP_TIP_RADIUS
 
 
 @njit(**INLINE)
@@ -27,24 +27,50 @@ def seat_centre_radius(pitch_radius, seat_radius, pin_radius):
 
 
 @njit(**INLINE)
-def _corner(dx, dy, r, ux, uy, rp, rg, rt):
-    """The nearer of the two corners of the seat in direction (ux, uy) (where its circle,
-    centred rp from the axis, meets the tip circle) to the point (dx, dy), all relative to
-    the axis: (distance, its unit direction towards the point)."""
-    a = (rp * rp + rt * rt - rg * rg) / (2.0 * rp)      # along u
-    b = math.sqrt(max(rt * rt - a * a, 0.0))           # across u
-    best = math.inf
-    nx = ny = 0.0
-    for sgn in (-1.0, 1.0):
-        cx = a * ux - sgn * b * uy
-        cy = a * uy + sgn * b * ux
-        ex = dx - cx
-        ey = dy - cy
-        d = math.sqrt(ex * ex + ey * ey)
-        if d < best:
-            best = d
-            nx, ny = ex / d, ey / d
-    return best, nx, ny
+def flank_length(rs, rg, rt, alpha):
+    """Length of a flank from the seat's half circle to the tip circle."""
+    b = rs * math.cos(alpha) + rg * math.sin(alpha)
+    return -b + math.sqrt(max(b * b - (rs * rs + rg * rg - rt * rt), 0.0))
+
+
+@njit(**INLINE)
+def _nearer(best, bx, by, px, py, qx, qy):
+    """The nearer of the current nearest point (bx, by) at squared distance best and the
+    point q, to p."""
+    d = (px - qx) ** 2 + (py - qy) ** 2
+    if d < best:
+        return d, qx, qy
+    return best, bx, by
+
+
+@njit(**INLINE)
+def _gap_nearest(a, b, rs, rg, rt, alpha, pitch):
+    """Nearest point of the profile to the point (a, b) in the frame of the nearest gap (a
+    along the gap's centre line from its seat centre, b across it, b >= 0: by symmetry one
+    side), as (squared distance, a, b) of that point."""
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    best, na, nb = math.inf, 0.0, 0.0
+    r = math.sqrt(a * a + b * b)
+    if a <= 0.0 and r > 0.0:        # the seat's half circle
+        best, na, nb = _nearer(best, na, nb, a, b, rg * a / r, rg * b / r)
+    best, na, nb = _nearer(best, na, nb, a, b, 0.0, rg)
+    t_end = flank_length(rs, rg, rt, alpha)        # the flank from (0, rg) along (cos, sin) alpha
+    t = min(max(a * ca + (b - rg) * sa, 0.0), t_end)
+    best, na, nb = _nearer(best, na, nb, a, b, t * ca, rg + t * sa)
+    # the tooth top beyond the flank's corner, on the tip circle, up to the half pitch
+    ox, oy = rs + a, b                              # the point seen from the axis, gap along x
+    corner = math.atan2(rg + t_end * sa, rs + t_end * ca)
+    ang = min(max(math.atan2(oy, ox), corner), 0.5 * pitch)
+    best, na, nb = _nearer(best, na, nb, a, b, rt * math.cos(ang) - rs, rt * math.sin(ang))
+    return best, na, nb
+
+
+@njit(**INLINE)
+def _in_gap(a, b, rg, alpha):
+    """Is the point (a, b >= 0) inside the gap's seat or between its flanks?"""
+    if a <= 0.0:
+        return a * a + b * b < rg * rg
+    return b < rg + a * math.tan(alpha)
 
 
 @njit(**INLINE)
@@ -53,40 +79,31 @@ def pin_on_sprocket(dx, dy, angle, lp):
     (penetration, nx, ny, inside). The penetration is r_pin minus the distance to the
     profile (contact where > 0), (nx, ny) the unit direction that pushes the pin out of
     it; inside is True where the pin's centre lies inside a tooth (it went through)."""
-    n = lp[LP_TEETH]
     rg = lp[LP_SEAT_RADIUS]
     rt = lp[LP_TIP_RADIUS]
     rpin = lp[LP_PIN_RADIUS]
-    rp = seat_centre_radius(lp[LP_PITCH_RADIUS], rg, rpin)
+    alpha = lp[LP_FLANK_ANGLE]
+    rs = seat_centre_radius(lp[LP_PITCH_RADIUS], rg, rpin)
     r = math.sqrt(dx * dx + dy * dy)
-    if r >= rt + rpin or r == 0.0:
+    if r >= rt + rpin:
         return -1.0, 0.0, 0.0, False
-    pitch = 2.0 * math.pi / n
-    k = math.floor((math.atan2(dy, dx) - angle) / pitch + 0.5)   # the nearest seat
+    pitch = 2.0 * math.pi / lp[LP_TEETH]
+    k = math.floor((math.atan2(dy, dx) - angle) / pitch + 0.5)   # the nearest gap
     ga = angle + k * pitch
     ux = math.cos(ga)
     uy = math.sin(ga)
-    ex = dx - rp * ux
-    ey = dy - rp * uy
-    d = math.sqrt(ex * ex + ey * ey)
-    if d < rg:                          # in the seat's circle
-        if d == 0.0:
-            return rpin - rg, -ux, -uy, False
-        wx = rp * ux + rg * ex / d       # the wall point in line with the pin
-        wy = rp * uy + rg * ey / d
-        if wx * wx + wy * wy <= rt * rt:
-            return rpin - (rg - d), -ex / d, -ey / d, False
-        dist, nx, ny = _corner(dx, dy, r, ux, uy, rp, rg, rt)
-        return rpin - dist, nx, ny, False
-    if r <= rt:
-        return rpin, dx / r, dy / r, True   # inside a tooth
-    # beyond the tip circle: the tip arc in line with the pin, unless that point is in the seat
-    tx = rt * dx / r - rp * ux
-    ty = rt * dy / r - rp * uy
-    if tx * tx + ty * ty >= rg * rg:
-        return rpin - (r - rt), dx / r, dy / r, False
-    dist, nx, ny = _corner(dx, dy, r, ux, uy, rp, rg, rt)
-    return rpin - dist, nx, ny, False
+    a = dx * ux + dy * uy - rs
+    b = -dx * uy + dy * ux
+    side = 1.0 if b >= 0.0 else -1.0
+    b = abs(b)
+    inside = r < rt and not _in_gap(a, b, rg, alpha)
+    d2, na, nb = _gap_nearest(a, b, rs, rg, rt, alpha, pitch)
+    dist = math.sqrt(d2)
+    if inside or dist == 0.0:
+        return rpin + dist, 0.0, 0.0, inside
+    ea = (a - na) / dist
+    eb = side * (b - nb) / dist
+    return rpin - dist, ea * ux - eb * uy, ea * uy + eb * ux, False
 
 
 def pitch_radius(link_pitch, teeth):
@@ -94,26 +111,30 @@ def pitch_radius(link_pitch, teeth):
     return link_pitch / (2.0 * math.sin(math.pi / teeth))
 
 
-def profile(teeth, pitch_radius, seat_radius, tip_radius, pin_radius, angle=0.0, per_arc=12):
-    """The tooth profile as a closed polyline (n, 2) about the axis, for drawing."""
+def profile(teeth, pitch_radius, seat_radius, tip_radius, pin_radius, angle=0.0, per_arc=12,
+            flank_angle=math.radians(15.0)):
+    """The tooth profile as a closed polyline (n, 2) about the axis, for drawing; angles in rad."""
     import numpy as np
-    rg, rt = seat_radius, tip_radius
-    rp = pitch_radius + seat_radius - pin_radius
+    rg, rt, al = seat_radius, tip_radius, flank_angle
+    rs = pitch_radius + seat_radius - pin_radius
     pitch = 2.0 * math.pi / teeth
-    a = (rp * rp + rt * rt - rg * rg) / (2.0 * rp)
-    half_tip = math.atan2(math.sqrt(max(rt * rt - a * a, 0.0)), a)     # seat corner, seen from the axis
+    t_end = flank_length(rs, rg, rt, al)
+    corner = math.atan2(rg + t_end * math.sin(al), rs + t_end * math.cos(al))
+    local = []          # one gap and the tooth top after it, in the gap's frame (x along the gap)
+    for t in np.linspace(t_end, 0.0, max(2, per_arc // 3)):          # flank on the -b side, inwards
+        local.append((rs + t * math.cos(al), -(rg + t * math.sin(al))))
+    for f in np.linspace(-0.5 * math.pi, 0.5 * math.pi, per_arc)[1:-1]:   # the seat's inner half circle
+        local.append((rs - rg * math.cos(f), rg * math.sin(f)))
+    for t in np.linspace(0.0, t_end, max(2, per_arc // 3)):          # flank on the +b side, outwards
+        local.append((rs + t * math.cos(al), rg + t * math.sin(al)))
+    for f in np.linspace(corner, pitch - corner, per_arc)[1:-1]:     # tooth top
+        local.append((rt * math.cos(f), rt * math.sin(f)))
+    local = np.array(local)
     pts = []
     for k in range(teeth):
         g = angle + k * pitch
-        gx, gy = rp * math.cos(g), rp * math.sin(g)
-        # seat arc: from the corner at g - half_tip round the inside to g + half_tip
-        c0 = math.atan2(rt * math.sin(g - half_tip) - gy, rt * math.cos(g - half_tip) - gx)
-        c1 = math.atan2(rt * math.sin(g + half_tip) - gy, rt * math.cos(g + half_tip) - gx)
-        if c1 > c0:
-            c1 -= 2.0 * math.pi
-        for t in np.linspace(c0, c1, per_arc):
-            pts.append((gx + rg * math.cos(t), gy + rg * math.sin(t)))
-        for t in np.linspace(g + half_tip, g + pitch - half_tip, max(2, per_arc // 3)):
-            pts.append((rt * math.cos(t), rt * math.sin(t)))
-    pts.append(pts[0])
-    return np.array(pts)
+        c, s = math.cos(g), math.sin(g)
+        pts.append(np.column_stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]]))
+    pts = np.vstack(pts)
+    return np.vstack([pts, pts[:1]])
+

@@ -1,0 +1,203 @@
+"""The closed track: sprocket, idler and tensioner, rollers, drive (model/closed.py,
+model/loop.py, model/sprocket.py, model/drive.py)."""
+
+import importlib
+import json
+import math
+
+import numpy as np
+import pytest
+
+import trackbench as tb
+from trackbench.model import layout as L
+from trackbench.model.drive import drive_torque
+from trackbench.model.sprocket import pin_on_sprocket, profile
+from trackbench.scenario import ScenarioError
+
+S = importlib.import_module("trackbench.simulate")
+
+FLAT = {"track.layout": "closed", "terrain": {"kind": "flat"}}
+
+
+@pytest.fixture(scope="module")
+def rest():
+    sc = tb.Scenario.from_dict({**FLAT, "drive.kind": "speed", "drive.target": 0.0, "speed": 0.0,
+                                "duration": 0.02})
+    return sc, S.equilibrium(sc)
+
+
+def test_rest_ground_carries_the_weight(rest):
+    _, eq = rest
+    assert eq.residual < 1e-6 * eq.weight
+    assert abs(eq.ground_force - eq.weight) < 1e-9 * eq.weight
+
+
+def _world(sc, eq, body):
+    th = eq.q[L.Q_PITCH]
+    c, s = math.cos(th), math.sin(th)
+    return np.array([eq.q[L.Q_X] + c * body[0] - s * body[1], eq.q[L.Q_Y] + s * body[0] + c * body[1]])
+
+
+def test_rest_span_tensions_balance_the_tensioner(rest):
+    """The tensioner's force along the guide equals the two free spans' tensions resolved
+    along it (beyond_paper.md: within 2 %)."""
+    sc, eq = rest
+    g = S.closed_parts(sc)[0]
+    th = eq.q[L.Q_PITCH]
+    u = np.array([math.cos(th) * g.guide[0] - math.sin(th) * g.guide[1],
+                  math.sin(th) * g.guide[0] + math.cos(th) * g.guide[1]])
+    centre = _world(sc, eq, g.idler + eq.info["idler_slide"] * g.guide)
+    pins = eq.info["pins"]                      # pins 1..n; link b joins pins b and b+1, link 0 pin n and pin 1
+    n = len(pins)
+    reach = math.hypot(sc["idler.radius"] + sc["track.pad_wheel"], 0.5 * sc["track.link_length"])
+    wrapped = np.hypot(*(pins - centre).T) < reach + 2e-3
+    pull = 0.0
+    spans = 0
+    for b in range(n):                          # link b: pin row b (pins[b - 1]) -> pin row b + 1 (pins[b])
+        wa, wz = wrapped[b - 1], wrapped[b]
+        if wa != wz:
+            # the next link along the free span: out of contact, its tension the span's
+            k = (b + 1) % n if wa else (b - 1) % n
+            a, z = pins[k - 1], pins[k]
+            d = (z - a) if wa else (a - z)      # away from the idler along the span
+            pull += eq.tension[k] * (d @ u) / np.hypot(*d)
+            spans += 1
+    assert spans == 2
+    force = eq.info["idler_force"]
+    assert force > 0.0
+    assert abs(force + pull) < 0.02 * force
+
+
+def test_rest_stays_at_rest(rest):
+    """From the equilibrium, with the speed drive holding 0 m/s, nothing moves."""
+    sc, eq = rest
+    ds = tb.simulate(sc)
+    assert ds.attrs["status"] == "completed"
+    assert float(np.ptp(ds.chassis_y.values)) < 1e-9
+    assert float(abs(ds.sprocket_speed).max()) < 1e-6
+    assert float(abs(ds.energy_residual).max()) < 1e-6
+    assert abs(float(ds.ground_force_y[-1]) - ds.attrs["weight"]) < 1e-6 * ds.attrs["weight"]
+    for name in ("sprocket_angle", "sprocket_speed", "sprocket_torque", "idler_position", "idler_force",
+                 "drive_work", "span_tension", "peak_sprocket_torque", "peak_idler_force"):
+        assert name in ds
+    assert ds.pin.size == sc["track.n_links"]
+
+
+def test_moving_start_runs_round_the_loop(rest):
+    """Moving: the ground run at rest, the top run at twice the speed, the sprocket turning
+    to match."""
+    sc0, _ = rest
+    sc = sc0.with_overrides({"speed": 10.0})
+    eq = S.equilibrium(sc)
+    y0 = S.initial_state(sc, eq)
+    nq = eq.q.size
+    nw, n = sc["vehicle.n_wheels"], sc["track.n_links"]
+    off = L.pin_offset(nw)
+    pins = eq.q[off:off + 2 * n].reshape(n, 2)
+    vel = y0[nq + off:nq + off + 2 * n].reshape(n, 2)
+    low = pins[:, 1] < pins[:, 1].min() + 2e-3
+    high = pins[:, 1] > pins[:, 1].max() - 0.05
+    assert low.sum() >= 10 and high.sum() >= 10
+    assert np.abs(vel[low]).max() < 0.05           # the ground run's links are nearly straight
+    assert np.allclose(vel[high, 0], 20.0, rtol=1e-3)
+    rp = sc["sprocket.pitch_radius"]
+    assert y0[nq + L.q_sprocket(nw, n)] == pytest.approx(-10.0 / rp)
+
+
+def test_derived_values_written_into_the_scenario():
+    sc = tb.Scenario.from_dict(FLAT)
+    assert sc["track.n_links"] > 30                 # the loop, not the paper's 30
+    assert sc["sprocket.pitch_radius"] == pytest.approx(
+        (0.19 + 80e3 / 8e6) / (2 * math.sin(math.pi / 10)))
+    assert sc["idler.preload"] > 80e3
+    given = tb.Scenario.from_dict({**FLAT, "idler.preload": 150e3})
+    assert given["idler.preload"] == 150e3
+
+
+@pytest.mark.parametrize("over, words", [
+    ({"sprocket.teeth": 8, "sprocket.pitch_radius": 0.3236}, "sprocket.teeth = 8"),
+    ({"track.n_links": 55}, "idler would leave its guide"),
+    ({"solver": "lee"}, "solver = 'lee'"),
+    ({"contact.damping": "hunt_crossley", "contact.restitution": 0.5}, "sprocket teeth"),
+    ({"drive.kind": "torque"}, "drive.torque"),
+    ({"sprocket.pin_radius": 0.04}, "sprocket.pin_radius"),
+    ({"rollers.positions": [[0.0, 2.0]]}, "rollers.positions[0]"),
+    ({"drive.curve": [[1.0, 2.0], [0.5, 3.0]]}, "drive.curve"),
+])
+def test_bad_closed_input(over, words):
+    with pytest.raises(ScenarioError) as e:
+        tb.Scenario.from_dict({**FLAT, **over})
+    assert words in str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_closed_parameters_need_the_closed_layout():
+    with pytest.raises(ScenarioError, match="closed track only"):
+        tb.Scenario.from_dict({"drive.kind": "speed"})
+
+
+def test_speed_drive_pi_and_anti_windup():
+    lp = np.zeros(L.N_LOOP)
+    lp[L.LP_DRIVE_KIND] = 2
+    lp[L.LP_TARGET] = 10.0
+    lp[L.LP_GAIN_P] = 100.0
+    lp[L.LP_GAIN_I] = 10.0
+    lp[L.LP_TORQUE_LIMIT] = 500.0
+    assert drive_torque(lp, 9.0, 0.0, 2.0) == pytest.approx((120.0, 1.0))
+    # clipped: the integral stops growing in the clipped direction, may shrink
+    assert drive_torque(lp, 0.0, 0.0, 100.0) == pytest.approx((500.0, 0.0))
+    assert drive_torque(lp, 11.0, 0.0, 100.0) == pytest.approx((500.0, -1.0))
+    lp[L.LP_DRIVE_KIND] = 1
+    lp[L.LP_CURVE] = 2
+    lp[L.LP_CURVE + 1:L.LP_CURVE + 5] = [0.0, 1000.0, 10.0, 0.0]
+    assert drive_torque(lp, 0.0, 5.0, 0.0)[0] == pytest.approx(500.0)
+    assert drive_torque(lp, 0.0, 20.0, 0.0)[0] == pytest.approx(0.0)
+
+
+RT = 0.3236 + 0.027
+
+
+def _loop_vector(teeth=10, rp=0.3236, rg=0.03, rt=RT, rpin=0.027):
+    lp = np.zeros(L.N_LOOP)
+    lp[[L.LP_TEETH, L.LP_PITCH_RADIUS, L.LP_SEAT_RADIUS, L.LP_TIP_RADIUS, L.LP_PIN_RADIUS]] = teeth, rp, rg, rt, rpin
+    lp[L.LP_FLANK_ANGLE] = math.radians(15.0)
+    return lp
+
+
+def test_tooth_profile_distance_matches_the_drawn_profile():
+    """The pin's penetration is r_pin minus its distance to the profile: checked against a
+    finely drawn profile at random points outside the teeth."""
+    lp = _loop_vector()
+    poly = profile(10, 0.3236, 0.03, RT, 0.027, angle=0.3, per_arc=600)
+    rng = np.random.default_rng(1)
+    checked = 0
+    for _ in range(400):
+        r = rng.uniform(0.29, 0.39)
+        a = rng.uniform(0.0, 2 * math.pi)
+        p = np.array([r * math.cos(a), r * math.sin(a)])
+        pen, nx, ny, inside = pin_on_sprocket(p[0], p[1], 0.3, lp)
+        if inside or pen < -0.027 + 1e-9:
+            continue
+        seg_a, seg_b = poly[:-1], poly[1:]
+        d = seg_b - seg_a
+        t = np.clip(((p - seg_a) * d).sum(1) / (d * d).sum(1), 0.0, 1.0)
+        dist = np.hypot(*(seg_a + t[:, None] * d - p).T).min()
+        assert 0.027 - pen == pytest.approx(dist, abs=2e-5)
+        checked += 1
+    assert checked > 100
+
+
+def test_seated_pin_on_the_pitch_circle_just_touches():
+    lp = _loop_vector()
+    pen, nx, ny, inside = pin_on_sprocket(0.3236 * math.cos(0.3), 0.3236 * math.sin(0.3), 0.3, lp)
+    assert not inside
+    assert pen == pytest.approx(0.0, abs=1e-12)
+    assert (nx, ny) == pytest.approx((math.cos(0.3), math.sin(0.3)))
+
+
+def test_closed_run_attributes_describe_the_layout(rest):
+    sc, _ = rest
+    ds = tb.simulate(sc.with_overrides({"duration": 2e-3}))
+    cl = json.loads(ds.attrs["closed_layout"])
+    assert ds.attrs["track_layout"] == "closed"
+    assert cl["teeth"] == 10 and len(cl["sprocket"]) == 2
