@@ -176,8 +176,8 @@ def plot_configuration(ds, times, path):
         cx = 0.5 * (float(ds["pin_x"].values[i].min()) + float(ds["pin_x"].values[i].max()))
         draw_configuration(ax, ds, i, x_range=(cx - width / 2, cx + width / 2))
     _tension_colorbar(fig, list(axes))
-    parts = ("\nclosed track: sprocket with its teeth (blue, the line marks its turn), idler on its guide (bronze bar), "
-             "support rollers" if G.is_closed(ds) else "")
+    parts = ("\nclosed track: sprocket with its teeth (blue, the line marks its turn), "
+             "idler on its guide (bronze bar), support rollers" if G.is_closed(ds) else "")
     fig.suptitle(f"{_name(ds)}: configuration (cf. Figs. 8-10); arrows: wheel-track force on the wheels (red), "
                  f"total ground force (purple), 1 m = {1e-3 / G.FORCE_SCALE:.0f} kN{_status_note(ds)}{parts}",
                  fontsize=9.5)
