@@ -112,8 +112,9 @@ def test_logged_values_equal_the_dataset(run_folder, step_run):
     np.testing.assert_allclose(-hull[:, 0, 1], step_run["chassis_y"].values + s * bx + c * by, atol=1e-5)
 
 
-def test_blueprint_is_stored(run_folder):
-    r = RrdReader(run_folder / "recording.rrd")
+def blueprint_views(path):
+    """The stored blueprint's views: space origin -> view class ("2D", "TimeSeries", ...)."""
+    r = RrdReader(path)
     (bp,) = r.blueprints()
     views = {}
     for c in r.stream(store=bp).to_chunks():
@@ -121,10 +122,19 @@ def test_blueprint_is_stored(run_folder):
         if "ViewBlueprint:space_origin" in rb.schema.names:
             views[rb.column("ViewBlueprint:space_origin").to_pylist()[0][0]] = \
                 rb.column("ViewBlueprint:class_identifier").to_pylist()[0][0]
+    return views
+
+
+def test_blueprint_is_stored(run_folder):
+    views = blueprint_views(run_folder / "recording.rrd")
     assert views.get("/world") == "2D"
     for e in (R.E_WHEEL_FY, R.E_AY, R.E_VX):
         assert views.get(e) == "TimeSeries"
     assert views.get(R.E_PARAMS) == "TextDocument"
+    # the closed layout's plots and parts belong to closed runs only
+    assert R.E_SPROCKET_TORQUE not in views and R.E_IDLER_FORCE not in views
+    logged = set(read_temporal(run_folder / "recording.rrd")) | static_entities(run_folder / "recording.rrd")
+    assert not logged & {R.E_SPROCKET, R.E_IDLER, R.E_GUIDE, R.E_ROLLERS, R.E_SPROCKET_TORQUE, R.E_IDLER_FORCE}
 
 
 def test_parameters_and_solver_text(step_run):
@@ -240,3 +250,120 @@ def test_view_of_a_netcdf_writes_the_recording_beside_it(step_run, tmp_path):
     nc = write_netcdf(step_run, tmp_path / "paper_step.nc")
     rrd = V.resolve_recording(nc)
     assert rrd == tmp_path / "paper_step.rrd" and rrd.stat().st_size > 100_000
+
+
+# ------------------------------------------------------------------ closed track layout ----
+
+CLOSED_PARTS = (R.E_SPROCKET, R.E_IDLER, R.E_GUIDE, R.E_ROLLERS)
+
+
+@pytest.fixture(scope="module")
+def closed_run():
+    """A short closed-layout run on flat ground with two support rollers on the return run."""
+    return tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "terrain": {"kind": "flat"}, "duration": 0.02,
+                                              "speed": 2.0, "rollers.positions": [[1.0, 0.2], [-1.0, 0.2]]}))
+
+
+@pytest.fixture(scope="module")
+def closed_recording(closed_run, tmp_path_factory):
+    return R.write_recording(closed_run, tmp_path_factory.mktemp("closed") / "recording.rrd")
+
+
+def test_link_ends_close_the_loop_and_free_pins():
+    pins = np.arange(8.0).reshape(4, 2)
+    paper = G.link_ends(pins, closed=False)
+    assert paper.shape == (3, 2, 2)
+    np.testing.assert_array_equal(paper[0], pins[[0, 1]])
+    loop = G.link_ends(pins, closed=True)
+    assert loop.shape == (4, 2, 2)
+    np.testing.assert_array_equal(loop[0], pins[[3, 0]])     # link 0: the last pin back to the first
+    np.testing.assert_array_equal(loop[2], pins[[1, 2]])
+    np.testing.assert_array_equal(G.free_pins(pins, False), pins[1:-1])
+    np.testing.assert_array_equal(G.free_pins(pins, True), pins)
+
+
+def test_closed_recording_draws_sprocket_idler_rollers_and_loop(closed_run, closed_recording):
+    from trackbench.model.sprocket import profile
+    ds, lay = closed_run, G.closed_layout(closed_run)
+    n, npin = ds.sizes["time"], ds.sizes["pin"]
+    data = read_temporal(closed_recording)
+    for e in CLOSED_PARTS + (R.E_SPROCKET_TORQUE, R.E_IDLER_FORCE, R.E_LINKS, R.E_PINS):
+        assert len(data[e][R.TIMELINE]) == n, e
+    assert set(CLOSED_PARTS) <= static_entities(closed_recording)
+    # the sprocket: its whole tooth profile at every frame, turned by its absolute angle
+    teeth = np.array(data[R.E_SPROCKET]["LineStrips2D:strips"], dtype=float)[:, 0]        # (n, m, 2)
+    angle = ds["chassis_pitch"].values - ds["sprocket_angle"].values
+    c, s = np.cos(ds["chassis_pitch"].values), np.sin(ds["chassis_pitch"].values)
+    (bx, by), x, y = lay["sprocket"], ds["chassis_x"].values, ds["chassis_y"].values
+    for i in (0, n - 1):
+        want = profile(lay["teeth"], lay["pitch_radius"], lay["seat_radius"], lay["tip_radius"], lay["pin_radius"],
+                       angle[i]) + [x[i] + c[i] * bx - s[i] * by, y[i] + s[i] * bx + c[i] * by]
+        assert teeth.shape[1] == len(want)
+        np.testing.assert_allclose(teeth[i], want * [1, -1], atol=1e-5)
+    # idler at its centre, on a guide 2 x travel long through its slide-0 point
+    idler = np.array(data[R.E_IDLER]["Ellipses2D:centers"], dtype=float)[:, 0]
+    np.testing.assert_allclose(idler, np.stack([ds["idler_x"].values, -ds["idler_y"].values], axis=-1), atol=1e-5)
+    guide = np.array(data[R.E_GUIDE]["LineStrips2D:strips"], dtype=float)[:, 0]           # (n, 2, 2)
+    np.testing.assert_allclose(np.linalg.norm(guide[:, 1] - guide[:, 0], axis=-1), 2 * lay["travel"], rtol=1e-5)
+    middle = guide.mean(axis=1) * [1, -1]
+    slide = np.sum((np.stack([ds["idler_x"].values, ds["idler_y"].values], axis=-1) - middle)
+                   * (guide[:, 1] - guide[:, 0]) * [1, -1], axis=-1) / (2 * lay["travel"])
+    np.testing.assert_allclose(slide, ds["idler_position"].values, atol=1e-5)
+    assert {len(v) for v in data[R.E_ROLLERS]["Ellipses2D:centers"]} == {2}
+    # the loop: every pin free, one link per pin, link 0 from the last pin back to the first
+    assert {len(v) for v in data[R.E_PINS]["Points2D:positions"]} == {npin}
+    links = np.array(data[R.E_LINKS]["LineStrips2D:strips"], dtype=float)                  # (n, nl, 2, 2)
+    pins = np.array(data[R.E_PINS]["Points2D:positions"], dtype=float)
+    assert links.shape[1] == npin == ds.sizes["link"]
+    np.testing.assert_array_equal(links[:, 0, 0], pins[:, -1])
+    np.testing.assert_array_equal(links[:, 0, 1], pins[:, 0])
+    np.testing.assert_array_equal(links[:, 1:, 0], pins[:, :-1])
+    colors = np.array(data[R.E_LINKS]["LineStrips2D:colors"], dtype=np.uint32)
+    np.testing.assert_array_equal(colors, G.tension_rgba32(ds["link_tension"].values))
+    # the recording draws what the matplotlib side view draws
+    g = G.side_view(ds)
+    np.testing.assert_allclose(teeth, g["sprocket"] * [1, -1], atol=1e-5)
+    np.testing.assert_allclose(links, g["links"] * [1, -1], atol=1e-5)
+    np.testing.assert_allclose(np.array(data[R.E_ROLLERS]["Ellipses2D:centers"], dtype=float),
+                               g["rollers"] * [1, -1], atol=1e-5)
+
+
+def test_closed_recording_signals_and_blueprint(closed_run, closed_recording):
+    data = read_temporal(closed_recording)
+    for e, var in ((R.E_SPROCKET_TORQUE, "sprocket_torque"), (R.E_IDLER_FORCE, "idler_force")):
+        got = np.array([v[0] for v in data[e]["Scalars:scalars"]])
+        np.testing.assert_array_equal(got, closed_run[var].values)
+    assert np.all(closed_run["idler_force"].values > 0)   # the tensioner holds the loop taut: a real signal
+    views = blueprint_views(closed_recording)
+    assert views.get(R.E_SPROCKET_TORQUE) == "TimeSeries" and views.get(R.E_IDLER_FORCE) == "TimeSeries"
+    assert views.get("/world") == "2D" and views.get(R.E_WHEEL_FY) == "TimeSeries"
+
+
+def test_closed_recording_thinned_and_without_rollers(closed_run, tmp_path):
+    ds = closed_run.copy()
+    lay = G.closed_layout(ds)
+    ds.attrs = {**ds.attrs, "closed_layout": json.dumps({**lay, "rollers": []})}
+    p = R.write_recording(ds, tmp_path / "r.rrd", every=7)
+    data = read_temporal(p)
+    idx = R.frame_indices(ds.sizes["time"], 7)
+    np.testing.assert_allclose(seconds(data[R.E_SPROCKET][R.TIMELINE]), ds["time"].values[idx], atol=1e-9)
+    assert R.E_ROLLERS not in data and R.E_ROLLERS not in static_entities(p)
+    assert len(data[R.E_IDLER_FORCE][R.TIMELINE]) == ds.sizes["time"]
+
+
+def test_closed_configuration_png(closed_run, tmp_path):
+    import matplotlib.image as mpimg
+    from trackbench.replay.plots import plot_configuration
+    path = plot_configuration(closed_run, (0.0, 0.02), tmp_path / "configuration.png")
+    assert path.exists() and path.stat().st_size > 20_000
+    img = mpimg.imread(path)[..., :3]
+    assert img.shape[0] > 400 and img.shape[1] > 600
+    assert np.mean(np.any(img < 0.9, axis=-1)) > 0.03
+
+    def share(hex_rgb, tol=0.03):
+        rgb = np.array([int(hex_rgb[k:k + 2], 16) for k in (1, 3, 5)]) / 255
+        return np.all(np.abs(img - rgb) < tol, axis=-1).mean()
+
+    # sprocket face (pale blue), idler guide (bronze bar), track tension colours (green)
+    assert share("#c9d3e6") > 0.001 and share("#b4783c") > 0.0001
+    assert share("#%02x%02x%02x" % tuple(G.TENSION_RGB[2].astype(int)), 0.06) > 0.001

@@ -15,6 +15,10 @@ Drawing choices (documented in results_schema.md, section "recording"):
   ground points of the free pins that touch the ground, weighted by their pad
   compression (h_g - distance to the ground). The arrow comes from below the ground.
 - Scale of every force arrow: FORCE_SCALE metres per newton (1 m per 200 kN).
+- Closed track layout (attrs["track_layout"] == "closed"): the pins form a loop, the last
+  joined to the first by link 0; every pin is free. The sprocket is its tooth profile
+  (model.sprocket.profile) turned by its absolute angle, the idler a circle on a guide
+  segment 2 x travel long, fixed in the chassis, the support rollers circles.
 """
 
 import json
@@ -91,6 +95,70 @@ def _rotate(c, s, bx, by):
     """Body points (bx, by) rotated by the pitch (c = cos, s = sin, shape (n,))."""
     bx, by = np.asarray(bx, float), np.asarray(by, float)
     return (c[:, None] * bx - s[:, None] * by, s[:, None] * bx + c[:, None] * by)
+
+
+def is_closed(ds):
+    """True for a closed-layout run (the paper layout's Datasets carry no track_layout)."""
+    return ds.attrs.get("track_layout") == "closed"
+
+
+def free_pins(pins, closed):
+    """The pins (..., np, 2) that can touch the ground: the paper's first and last pins are
+    fixed on the chassis, every pin of the closed loop is free."""
+    return pins if closed else pins[..., 1:-1, :]
+
+
+def link_ends(pins, closed):
+    """Pins (..., np, 2) -> the two ends of every link (..., nl, 2, 2), in link order. The
+    paper's link b joins pins b and b+1; the closed loop's link 0 joins the last pin back to
+    the first (its link b the pins b-1 and b in array order), which closes the drawing."""
+    start = np.roll(pins, 1, axis=-2) if closed else pins[..., :-1, :]
+    end = pins if closed else pins[..., 1:, :]
+    return np.stack([start, end], axis=-2)
+
+
+def closed_layout(ds):
+    """The closed layout's parts (attrs['closed_layout']: body points and sizes of the
+    sprocket, the idler and its guide, the rollers)."""
+    return attr_json(ds, "closed_layout")
+
+
+def sprocket_outline(lay):
+    """The sprocket's tooth profile at angle 0 about its axis (m, 2), closed. Every frame
+    draws it turned by the sprocket's angle: the seats are laid out from that angle, so the
+    turned outline is profile(angle) without building the polyline again frame by frame."""
+    from ..model.sprocket import profile
+    return profile(lay["teeth"], lay["pitch_radius"], lay["seat_radius"], lay["tip_radius"], lay["pin_radius"])
+
+
+def _world(x, y, c, s, body):
+    """Body points (k, 2) at the frames' chassis positions (x, y) and pitch (c, s): (n, k, 2)."""
+    body = np.asarray(body, float).reshape(-1, 2)
+    rx, ry = _rotate(c, s, body[:, 0], body[:, 1])
+    return np.stack([x[:, None] + rx, y[:, None] + ry], axis=-1)
+
+
+def closed_parts(lay, outline, x, y, pitch, sprocket_angle, idler_x, idler_y):
+    """The closed layout's parts at some frames (every argument but lay and outline (n,)).
+
+    sprocket (n, m, 2): the outline turned by the sprocket's absolute angle (pitch -
+    sprocket_angle: sprocket_angle is relative to the chassis, clockwise positive) about
+    its axis, sprocket_axis (n, 2); idler (n, 2) its centre; guide (n, 2, 2) the guide's
+    two ends, travel either side of the idler's slide-0 point and fixed in the chassis;
+    rollers (n, k, 2) their centres."""
+    c, s = np.cos(pitch), np.sin(pitch)
+    axis = _world(x, y, c, s, lay["sprocket"])                       # (n, 1, 2)
+    turn = pitch - sprocket_angle
+    tx, ty = _rotate(np.cos(turn), np.sin(turn), outline[:, 0], outline[:, 1])
+    half = float(lay["travel"]) * np.asarray(lay["guide"], float)
+    ends = np.asarray(lay["idler"], float) + np.stack([-half, half])
+    return {
+        "sprocket": axis + np.stack([tx, ty], axis=-1),
+        "sprocket_axis": axis[:, 0],
+        "idler": np.stack([idler_x, idler_y], axis=-1),
+        "guide": _world(x, y, c, s, ends),
+        "rollers": _world(x, y, c, s, lay["rollers"]),
+    }
 
 
 def covered_x_range(ds):
@@ -217,9 +285,10 @@ def side_view(ds, idx=None):
     """Geometry of the frames `idx` (default: all) as numpy arrays (n = len(idx)).
 
     Returns a dict: time (n,), chassis (n, 5, 2) closed outline, pivots and wheels
-    (n, nw, 2), pins (n, np, 2), tension (n, nl), wheel_force (n, nw, 2),
-    wheel_arrow_origin / wheel_arrow_vector (n, nw, 2), ground_arrow_origin /
-    ground_arrow_vector (n, 2); arrow vectors in m (FORCE_SCALE applied)."""
+    (n, nw, 2), pins (n, np, 2), links (n, nl, 2, 2) the two ends of each link, tension
+    (n, nl), wheel_force (n, nw, 2), wheel_arrow_origin / wheel_arrow_vector (n, nw, 2),
+    ground_arrow_origin / ground_arrow_vector (n, 2); arrow vectors in m (FORCE_SCALE
+    applied). A closed-layout run adds sprocket, idler, guide and rollers (closed_parts)."""
     if idx is None:
         idx = np.arange(ds.sizes["time"])
     idx = np.asarray(idx)
@@ -255,8 +324,15 @@ def side_view(ds, idx=None):
         "wheel_arrow_origin": wheels - reach * unit,
         "wheel_arrow_vector": FORCE_SCALE * f,
     }
+    closed = is_closed(ds)
+    out["links"] = link_ends(pins, closed)
+    if closed:
+        lay = closed_layout(ds)
+        out.update(closed_parts(lay, sprocket_outline(lay), x, y, th, take("sprocket_angle"),
+                                take("idler_x"), take("idler_y")))
     # ground force at the pad-compression-weighted centre of the free pins' ground contacts
-    centre = ground_arrow_centre(pins[:, 1:-1, 0], pins[:, 1:-1, 1], ground_polyline(ds), float(ds.attrs["pad_ground"]))
+    free = free_pins(pins, closed)
+    centre = ground_arrow_centre(free[..., 0], free[..., 1], ground_polyline(ds), float(ds.attrs["pad_ground"]))
     g = np.stack([take("ground_force_x"), take("ground_force_y")], axis=-1) * FORCE_SCALE
     out["ground_arrow_origin"] = centre - g
     out["ground_arrow_vector"] = g

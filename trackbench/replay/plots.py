@@ -96,8 +96,9 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False):
     for k, (wx, wy) in enumerate(wheels):
         ax.add_patch(Circle((wx, wy), r, facecolor="#f4f4f4", edgecolor="#222222", lw=1.3, zorder=3))
         ax.text(wx, wy + 0.02, str(int(ds["wheel"].values[k])), ha="center", va="center", fontsize=7, zorder=6)
-    segs = np.stack([pins[:-1], pins[1:]], axis=1)
-    lc = LineCollection(segs, colors=G.tension_rgb(g["tension"][0]) / 255.0, linewidths=2.4, zorder=4)
+    if G.is_closed(ds):
+        _draw_closed_parts(ax, ds, g)
+    lc = LineCollection(g["links"][0], colors=G.tension_rgb(g["tension"][0]) / 255.0, linewidths=2.4, zorder=4)
     ax.add_collection(lc)
     ax.plot(pins[:, 0], pins[:, 1], "o", color="#1e1e1e", ms=2.2, zorder=5)
     if arrows:
@@ -118,6 +119,28 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False):
     ax.set_ylabel("y (m)")
     ax.set_title(f"t = {float(g['time'][0]):.3f} s", fontsize=10)
     return lc
+
+
+def _draw_closed_parts(ax, ds, g):
+    """The closed layout's sprocket (tooth profile at this frame's angle, with a spoke to show
+    it turning), idler on its guide, and support rollers; under the track (zorder 3)."""
+    from matplotlib.patches import Circle, Polygon
+    lay = G.closed_layout(ds)
+    teeth = g["sprocket"][0]
+    ax.add_patch(Polygon(teeth[:-1], closed=True, facecolor="#c9d3e6", edgecolor="#283c6e", lw=1.0, zorder=3))
+    axis = np.asarray(g["sprocket_axis"][0])
+    ax.plot([axis[0], teeth[0, 0]], [axis[1], teeth[0, 1]], color="#283c6e", lw=1.0, zorder=3)
+    ax.plot([axis[0]], [axis[1]], "o", color="#283c6e", ms=3, zorder=4)
+    ix, iy = g["idler"][0]
+    ax.add_patch(Circle((ix, iy), float(lay["idler_radius"]), facecolor="#f4f4f4", edgecolor="#5a5a5a", lw=1.3,
+                        zorder=3))
+    # the guide is shorter than the idler is wide: drawn over the idler's face so it shows
+    guide = g["guide"][0]
+    ax.plot(guide[:, 0], guide[:, 1], color="#b4783c", lw=5, solid_capstyle="butt", zorder=3.5)
+    ax.plot([ix], [iy], "o", color="#3c3c3c", ms=4, zorder=4)
+    for rx, ry in g["rollers"][0]:
+        ax.add_patch(Circle((rx, ry), float(lay["roller_radius"]), facecolor="#f4f4f4", edgecolor="#787878",
+                            lw=1.1, zorder=3))
 
 
 def _arrow(ax, x, y, dx, dy, color, lw):
@@ -153,8 +176,11 @@ def plot_configuration(ds, times, path):
         cx = 0.5 * (float(ds["pin_x"].values[i].min()) + float(ds["pin_x"].values[i].max()))
         draw_configuration(ax, ds, i, x_range=(cx - width / 2, cx + width / 2))
     _tension_colorbar(fig, list(axes))
+    parts = ("\nclosed track: sprocket with its teeth (blue, the line marks its turn), "
+             "idler on its guide (bronze bar), support rollers" if G.is_closed(ds) else "")
     fig.suptitle(f"{_name(ds)}: configuration (cf. Figs. 8-10); arrows: wheel-track force on the wheels (red), "
-                 f"total ground force (purple), 1 m = {1e-3 / G.FORCE_SCALE:.0f} kN{_status_note(ds)}", fontsize=9.5)
+                 f"total ground force (purple), 1 m = {1e-3 / G.FORCE_SCALE:.0f} kN{_status_note(ds)}{parts}",
+                 fontsize=9.5)
     fig.savefig(path, dpi=DPI)
     plt.close(fig)
     return path

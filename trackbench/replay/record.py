@@ -40,11 +40,17 @@ E_LINKS = "/world/track/links"
 E_PINS = "/world/track/pins"
 E_WHEEL_FORCE = "/world/forces/wheel_track"
 E_GROUND_FORCE = "/world/forces/ground_track"
+E_SPROCKET = "/world/sprocket"                  # closed layout only: the tooth profile
+E_IDLER = "/world/idler/wheel"
+E_GUIDE = "/world/idler/guide"
+E_ROLLERS = "/world/rollers"
 E_WHEEL_FY = "/signals/wheel_force_y"          # one scalar per wheel per row (series "wheel 1" ...)
 E_AY = "/signals/chassis_ay"
 E_VX = "/signals/chassis_vx"
 E_ENERGY = "/signals/energy"                   # kinetic, elastic, gravity, balance per row
 E_TENSION = "/signals/link_tension_max"
+E_SPROCKET_TORQUE = "/signals/sprocket_torque"  # closed layout only
+E_IDLER_FORCE = "/signals/idler_force"
 E_PARAMS = "/info/parameters"
 E_SOLVER = "/info/solver"
 
@@ -59,6 +65,10 @@ ARM_RGB = (110, 110, 110)
 GROUND_RGB = (120, 85, 40)
 WHEEL_FORCE_RGB = (200, 0, 0)
 GROUND_FORCE_RGB = (150, 60, 200)
+SPROCKET_RGB = (40, 60, 110)
+IDLER_RGB = (90, 90, 90)
+GUIDE_RGB = (180, 120, 60)
+ROLLER_RGB = (120, 120, 120)
 
 
 _STRIP_TYPE = LineStrip2DBatch._ARROW_DATATYPE
@@ -193,7 +203,9 @@ def solver_text(ds):
 
 def blueprint(ds):
     """Side view large on the left; wheel forces, chassis acceleration and velocity on the
-    right; energies, link tension and the text documents in tabs below them."""
+    right; energies, link tension and the text documents in tabs below them. A closed-layout
+    run adds the drive torque and the tensioner force under the side view, where the
+    sprocket and the idler they act on are seen."""
     x0, x1 = G.covered_x_range(ds)
     ground = G.ground_polyline(ds, (x0, x1))
     top = float(np.nanmax(ds.variables["chassis_y"].values)) + G.HULL_TOP + 0.5
@@ -211,6 +223,10 @@ def blueprint(ds):
             rrb.TextDocumentView(origin=E_SOLVER, name="solver"),
         ),
     )
+    if G.is_closed(ds):
+        side = rrb.Vertical(side, rrb.Horizontal(
+            rrb.TimeSeriesView(origin=E_SPROCKET_TORQUE, name="sprocket drive torque (N m)"),
+            rrb.TimeSeriesView(origin=E_IDLER_FORCE, name="idler tensioner force (N)")), row_shares=[3, 1])
     return rrb.Blueprint(rrb.Horizontal(side, plots, column_shares=[3, 2]),
                          rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                          rrb.TimePanel(state="expanded", timeline=TIMELINE, playback_speed=PLAYBACK_SPEED))
@@ -240,6 +256,32 @@ def _static_styles(nw, r):
     }
 
 
+@functools.lru_cache(maxsize=16)
+def _closed_styles(idler_radius, roller_radius, n_rollers):
+    """The closed layout's static archetypes (as _static_styles): entity -> archetype."""
+    ri, rr_ = idler_radius, roller_radius
+    styles = {
+        E_SPROCKET: rr.LineStrips2D.from_fields(colors=[SPROCKET_RGB], radii=[0.008], labels=["sprocket"]),
+        E_IDLER: rr.Ellipses2D.from_fields(half_sizes=[[ri, ri]], colors=[IDLER_RGB], line_radii=[0.012],
+                                           labels=["idler"]),
+        E_GUIDE: rr.LineStrips2D.from_fields(colors=[GUIDE_RGB], radii=[0.03], labels=["idler guide"]),
+        E_SPROCKET_TORQUE: rr.SeriesLines(colors=[SPROCKET_RGB], names=["sprocket drive torque (N m)"]),
+        E_IDLER_FORCE: rr.SeriesLines(colors=[(0, 0, 0)], names=["idler tensioner force (N)"]),
+    }
+    if n_rollers:   # a layout without rollers has no roller entity at all
+        styles[E_ROLLERS] = rr.Ellipses2D.from_fields(half_sizes=[[rr_, rr_]] * n_rollers, colors=[ROLLER_RGB],
+                                                      line_radii=[0.01],
+                                                      labels=[f"roller {i + 1}" for i in range(n_rollers)])
+    return styles
+
+
+def _log_closed_static(rec, ds):
+    lay = G.closed_layout(ds)
+    styles = _closed_styles(float(lay["idler_radius"]), float(lay["roller_radius"]), len(lay["rollers"]))
+    for e, style in styles.items():
+        rec.log(e, style, static=True)
+
+
 def _log_static(rec, ds):
     styles = _static_styles(int(ds.sizes["wheel"]), float(ds.attrs["wheel_radius"]))
     rec.log(E_GROUND, rr.LineStrips2D([_flip(G.ground_polyline(ds))], colors=[GROUND_RGB], radii=[0.015],
@@ -249,6 +291,8 @@ def _log_static(rec, ds):
         rec.log(e, styles[e], static=True)
     rec.log(E_PARAMS, rr.TextDocument(parameters_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
     rec.log(E_SOLVER, rr.TextDocument(solver_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
+    if G.is_closed(ds):
+        _log_closed_static(rec, ds)
 
 
 def _log_signals(rec, ds, every=1):
@@ -270,24 +314,32 @@ def _log_signals(rec, ds, every=1):
     e = np.stack([ds.variables[var].values for _, var, _ in ENERGY_SERIES], axis=1)
     rec.send_columns(E_ENERGY, indexes=t, columns=scalars(e))
     rec.send_columns(E_TENSION, indexes=t, columns=scalars(np.nanmax(ds.variables["link_tension"].values, axis=1)))
+    if G.is_closed(ds):
+        rec.send_columns(E_SPROCKET_TORQUE, indexes=t, columns=scalars(ds.variables["sprocket_torque"].values))
+        rec.send_columns(E_IDLER_FORCE, indexes=t, columns=scalars(ds.variables["idler_force"].values))
 
 
 def _rows(a, idx):
     return a if idx is None else np.asarray(a)[idx]
 
 
-def _log_track(rec, t, take, n):
-    """Pins and links (coloured by tension) at the frames; returns the pins' x and y."""
+def _log_track(rec, t, take, n, closed=False):
+    """Pins and links (coloured by tension) at the frames; returns the pins' x and y.
+    The links' ends as geometry.link_ends: the closed loop has a link more than the
+    paper's track, link 0, from the last pin back to the first."""
     send = rec.send_columns
     pin_x, pin_y = take("pin_x"), take("pin_y")
     pins = _xy32(pin_x, pin_y)                                    # (n, np, 2)
     npin = pins.shape[1]
-    nl = npin - 1
+    shift = int(closed)          # the loop's link 0 comes first: the others move up one place
+    nl = npin - 1 + shift
     send(E_PINS, indexes=t, columns=[_Column(rr.Points2D.descriptor_positions(), _list(_vec2(pins), n, npin))])
     p64 = pins.view(np.uint64)[..., 0]                           # one (x, y) float32 pair as 8 bytes
     links64 = np.empty((n, nl, 2), dtype=np.uint64)
-    links64[:, :, 0] = p64[:, :-1]
-    links64[:, :, 1] = p64[:, 1:]
+    links64[:, shift:, 0] = p64[:, :-1]
+    links64[:, :, 1] = p64[:, 1 - shift:]
+    if closed:
+        links64[:, 0, 0] = p64[:, -1]
     links = links64.view(np.float32)                              # (n, nl, 4): the link's two ends
     colors = G.tension_rgba32(take("link_tension"))
     send(E_LINKS, indexes=t,
@@ -311,7 +363,11 @@ def _log_frames(rec, ds, idx):
 
     t = [rr.TimeColumn(TIMELINE, duration=take("time"))]
     send = rec.send_columns
-    pin_x, pin_y = _log_track(rec, t, take, n)
+    closed = G.is_closed(ds)
+    pin_x, pin_y = _log_track(rec, t, take, n, closed)
+    if closed:
+        _log_closed_parts(rec, ds, t, take, n)
+    free = slice(None) if closed else slice(1, -1)   # the pins that can touch the ground
 
     # chassis outline, arms (pivot to wheel centre), wheel-track force arrows (from the
     # contact region along the force), ground force (total) at the pad-compression-weighted
@@ -349,7 +405,7 @@ def _log_frames(rec, ds, idx):
         uy = np.where(pos, fyb / safe, 1.0)
         _xy32(wx[b] - reach * ux, wy[b] - reach * uy, out=origin[b])
         _xy32(G.FORCE_SCALE * fxb, G.FORCE_SCALE * fyb, out=vector[b])
-        centre = G.ground_arrow_centre(pin_x[b, 1:-1], pin_y[b, 1:-1], poly, hg)
+        centre = G.ground_arrow_centre(pin_x[b, free], pin_y[b, free], poly, hg)
         gx, gy = gfx[b] * G.FORCE_SCALE, gfy[b] * G.FORCE_SCALE
         _xy32(centre[:, 0] - gx, centre[:, 1] - gy, out=g_origin[b])
         _xy32(gx, gy, out=g_vector[b])
@@ -364,6 +420,34 @@ def _log_frames(rec, ds, idx):
     send(E_GROUND_FORCE, indexes=t,
          columns=[_Column(rr.Arrows2D.descriptor_origins(), _list(_vec2(g_origin), n, 1)),
                   _Column(rr.Arrows2D.descriptor_vectors(), _list(_vec2(g_vector), n, 1))])
+
+
+def _log_closed_parts(rec, ds, t, take, n):
+    """The closed layout's sprocket (its tooth profile, turned frame by frame), idler,
+    idler guide and rollers at the frames, as geometry.closed_parts (worked out in blocks
+    of frames straight into float32 buffers, y negated)."""
+    lay = G.closed_layout(ds)
+    outline = G.sprocket_outline(lay)
+    x, y, th = take("chassis_x"), take("chassis_y"), take("chassis_pitch")
+    angle, ix, iy = take("sprocket_angle"), take("idler_x"), take("idler_y")
+    nr = len(lay["rollers"])
+    bufs = {"sprocket": np.empty((n, len(outline), 2), dtype=np.float32),
+            "idler": np.empty((n, 2), dtype=np.float32),
+            "guide": np.empty((n, 2, 2), dtype=np.float32),
+            "rollers": np.empty((n, nr, 2), dtype=np.float32)}
+    for lo in range(0, n, _FRAME_BLOCK):
+        b = slice(lo, min(n, lo + _FRAME_BLOCK))
+        parts = G.closed_parts(lay, outline, x[b], y[b], th[b], angle[b], ix[b], iy[b])
+        for name, out in bufs.items():
+            _xy32(parts[name][..., 0], parts[name][..., 1], out=out[b])
+    strips = rr.LineStrips2D.descriptor_strips()
+    send = rec.send_columns
+    send(E_SPROCKET, indexes=t, columns=[_Column(strips, _list(_strip_values(bufs["sprocket"]), n, 1))])
+    send(E_GUIDE, indexes=t, columns=[_Column(strips, _list(_strip_values(bufs["guide"]), n, 1))])
+    send(E_IDLER, indexes=t, columns=[_Column(rr.Ellipses2D.descriptor_centers(), _list(_vec2(bufs["idler"]), n, 1))])
+    if nr:   # a layout without rollers logs no roller entity
+        send(E_ROLLERS, indexes=t,
+             columns=[_Column(rr.Ellipses2D.descriptor_centers(), _list(_vec2(bufs["rollers"]), n, nr))])
 
 
 def write_recording(ds, path, every=1, signal_every=1):
