@@ -283,7 +283,7 @@ def test_link_ends_close_the_loop_and_free_pins():
 
 
 def test_closed_recording_draws_sprocket_idler_rollers_and_loop(closed_run, closed_recording):
-    from trackbench.model.sprocket import profile
+    from trackbench.model.teeth import profile
     ds, lay = closed_run, G.closed_layout(closed_run)
     n, npin = ds.sizes["time"], ds.sizes["pin"]
     data = read_temporal(closed_recording)

@@ -15,7 +15,7 @@ import numpy as np
 
 from .model.contact_laws import DAMPINGS, GEOMETRIES, LAWS
 
-from .model.drive import DRIVES
+from .model.layout import DRIVES
 from .model.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle, wheel_centres_body
 from .presets import PRESETS, preset_values
 
@@ -374,14 +374,17 @@ def _pairs(name, value, increasing=False, limit=None):
 def _check_closed(out, explicit):
     """The closed layout: what it supports, its geometry (model/closed.py), and the values
     it derives written into the scenario unless given."""
-    from .model.closed import ClosedLayoutError, closed_geometry
-    from .model.layout import LP_CURVE_POINTS
-    closed = out["track"]["layout"] == "closed"
-    if not closed:
-        given = sorted(k for k in explicit if k.split(".")[0] in _CLOSED_GROUPS or k == "track.tension")
+    if out["track"]["layout"] != "closed":
+        # a closed-track value set to anything but its default on the paper's layout (a
+        # resolved scenario counts every value as given)
+        defaults = flatten({**closed_defaults(), "track": {"tension": paper_track()["tension"]}})
+        flat = flatten({k: out[k] for k in (*_CLOSED_GROUPS, "track")})
+        given = sorted(k for k in explicit if k in defaults and flat[k] != defaults[k])
         if given:
             raise ScenarioError(f"{given[0]} applies to the closed track only; set track.layout = 'closed'")
         return
+    from .model.closed import ClosedLayoutError, closed_geometry
+    from .model.layout import LP_CURVE_POINTS
     if out["solver"] == "lee":
         raise ScenarioError("solver = 'lee' runs the paper's track layout only; use solver = 'reduced' with "
                             "track.layout = 'closed'")

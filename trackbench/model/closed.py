@@ -22,7 +22,7 @@ import numpy as np
 
 from . import layout as L
 from .parameters import equilibrium_arm_angle, pivots
-from .sprocket import pitch_radius as _pitch_radius
+from .teeth import pitch_radius as _pitch_radius
 from .track_path import closed_loop, closed_track, link_count
 
 TOOTH_PITCH_TOLERANCE = 0.02   # the sprocket's tooth pitch within 2 % of the link pitch under tension
@@ -218,7 +218,6 @@ def _check_rollers(tr, rol, circles):
 def loop_vector(g, spr, idl, drive, contact_c):
     """The LP_* vector of the kernels. contact_c: the viscous coefficient of pin-tooth
     contacts (N s/m; 0 = none)."""
-    from .drive import DRIVES
     lp = np.zeros(L.N_LOOP)
     lp[L.LP_SPROCKET_X], lp[L.LP_SPROCKET_Y] = g.sprocket
     lp[L.LP_SPROCKET_INERTIA] = spr["inertia"]
@@ -236,7 +235,7 @@ def loop_vector(g, spr, idl, drive, contact_c):
     lp[L.LP_TENSIONER_STIFFNESS] = idl["stiffness"]
     lp[L.LP_TENSIONER_DAMPING] = idl["damping"]
     lp[L.LP_TRAVEL] = idl["travel"]
-    lp[L.LP_DRIVE_KIND] = DRIVES[drive["kind"]]
+    lp[L.LP_DRIVE_KIND] = L.DRIVES[drive["kind"]]
     lp[L.LP_DRIVE_TORQUE] = drive["torque"]
     lp[L.LP_TARGET] = drive["target"]
     lp[L.LP_GAIN_P] = drive["gain_p"]

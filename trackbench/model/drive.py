@@ -4,10 +4,8 @@ the direction that moves the vehicle towards +x) and the rate of its controller'
 from numba import njit
 
 from .jit import INLINE
-from .layout import LP_CURVE, LP_DRIVE_KIND, LP_DRIVE_TORQUE, LP_GAIN_I, LP_GAIN_P, LP_TARGET, LP_TORQUE_LIMIT
-
-DRIVE_NONE, DRIVE_TORQUE, DRIVE_SPEED = 0, 1, 2
-DRIVES = {"none": DRIVE_NONE, "torque": DRIVE_TORQUE, "speed": DRIVE_SPEED}
+from .layout import (DRIVE_SPEED, DRIVE_TORQUE, LP_CURVE, LP_DRIVE_KIND, LP_DRIVE_TORQUE, LP_GAIN_I, LP_GAIN_P,
+                     LP_TARGET, LP_TORQUE_LIMIT)
 
 
 @njit(**INLINE)

@@ -201,6 +201,10 @@ LP_CURVE = 24            # torque-speed curve: LP_CURVE_POINTS pairs (sprocket s
 LP_CURVE_POINTS = 16
 N_LOOP = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # [LP_CURVE] holds the number of points used
 
+# drive.kind codes (model/drive.py)
+DRIVE_NONE, DRIVE_TORQUE, DRIVE_SPEED = 0, 1, 2
+DRIVES = {"none": DRIVE_NONE, "torque": DRIVE_TORQUE, "speed": DRIVE_SPEED}
+
 # --- idler and support rollers, ``guides`` (row 0 the idler, then the rollers) ---------
 G_BX = 0                 # body point of the centre (the idler's at slide 0) (m)
 G_BY = 1

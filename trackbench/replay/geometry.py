@@ -23,6 +23,8 @@ Drawing choices (documented in results_schema.md, section "recording"):
 
 import json
 
+import math
+
 import numpy as np
 
 HULL_MARGIN = 0.1      # m beyond each track end
@@ -127,8 +129,9 @@ def sprocket_outline(lay):
     """The sprocket's tooth profile at angle 0 about its axis (m, 2), closed. Every frame
     draws it turned by the sprocket's angle: the seats are laid out from that angle, so the
     turned outline is profile(angle) without building the polyline again frame by frame."""
-    from ..model.sprocket import profile
-    return profile(lay["teeth"], lay["pitch_radius"], lay["seat_radius"], lay["tip_radius"], lay["pin_radius"])
+    from ..model.teeth import profile
+    return profile(lay["teeth"], lay["pitch_radius"], lay["seat_radius"], lay["tip_radius"], lay["pin_radius"],
+                   flank_angle=math.radians(lay["flank_angle"]))
 
 
 def _world(x, y, c, s, body):
