@@ -1,0 +1,109 @@
+"""The closed, driven track: the figures docs/validation.md and docs/benchmarks.md quote.
+Prints figures; asserts nothing. Takes several minutes.
+
+    python benchmarks/bench_closed.py            # everything
+    python benchmarks/bench_closed.py drive      # one part: rest, drive, traction, step, cost
+"""
+
+import sys
+import time
+
+import numpy as np
+
+import trackbench as tb
+
+CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6}
+REPEATS = 3
+
+
+def rest():
+    """At rest on flat ground: weight against ground force, tensioner against the spans."""
+    import importlib
+    S = importlib.import_module("trackbench.simulate")
+    sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat"}})
+    t = time.perf_counter()
+    eq = S.equilibrium(sc)
+    print(f"rest: equilibrium {time.perf_counter() - t:.2f} s, {eq.iterations} iterations, residual "
+          f"{eq.residual / eq.weight:.1e} of the weight, ground force - weight {abs(eq.ground_force - eq.weight) / eq.weight:.1e} "
+          f"of it; tensioner {eq.info['idler_force'] / 1e3:.1f} kN at slide {eq.info['idler_slide'] * 1e3:.1f} mm, "
+          f"holding torque {eq.info['holding_torque'] / 1e3:.2f} kN m, links {eq.tension.min() / 1e3:.1f}-"
+          f"{eq.tension.max() / 1e3:.1f} kN")
+
+
+def drive(target=10.0, duration=6.0):
+    """Speed drive from rest to `target` on flat ground, mu = 0.6: speed hold, torque against
+    (lower - upper span tension) x r_p, pins seated, energy residual."""
+    sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat"}, "speed": 0.0, "drive.kind": "speed",
+                                "drive.target": target, "duration": duration, "output_interval": 1e-3})
+    ds = tb.simulate(sc)
+    a = ds.attrs
+    print(f"drive: {a['status']} ({a['status_message']}), solve {a['solve_time']:.1f} s, steps {a['steps']}")
+    t = ds.time.values
+    vx = ds.chassis_vx.values
+    reach = t[np.argmax(vx >= 0.99 * target)] if (vx >= 0.99 * target).any() else np.nan
+    print(f"  speed reaches 99 % of {target} m/s at {reach:.2f} s")
+    late = t >= duration - 2.0
+    if np.isfinite(reach) and reach < duration - 2.0:
+        v = vx[late]
+        torque = ds.sprocket_torque.values[late]
+        span = ds.span_tension.values[late]
+        rp = sc["sprocket.pitch_radius"]
+        from_spans = np.nanmean(span[:, 1] - span[:, 0]) * rp
+        print(f"  last 2 s: speed {v.min():.3f}-{v.max():.3f} m/s (worst {100 * np.abs(v / target - 1).max():.2f} %), "
+              f"mean {v.mean():.3f}; mean torque {torque.mean() / 1e3:.3f} kN m, (lower - upper span) x r_p "
+              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %)")
+    print(f"  energy residual max {float(abs(ds.energy_residual).max()):.1e} of E0; drive work "
+          f"{float(ds.drive_work[-1]) / 1e3:.0f} kJ, dissipated {float(ds.energy_dissipated[-1]) / 1e3:.0f} kJ")
+    return ds
+
+
+def traction(torque=60e3, duration=1.0):
+    """A torque above what mu x weight carries: the track slips, the tractive force stays at
+    or below mu x weight."""
+    sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat"}, "speed": 0.0, "drive.kind": "torque",
+                                "drive.torque": torque, "duration": duration, "output_interval": 1e-3})
+    ds = tb.simulate(sc)
+    rp = sc["sprocket.pitch_radius"]
+    w = ds.attrs["weight"]
+    fx = ds.ground_force_x.values
+    late = ds.time.values > 0.5 * duration
+    print(f"traction: {ds.attrs['status']}, torque {torque / 1e3:.0f} kN m = {torque / rp / 1e3:.0f} kN at the pitch "
+          f"circle against mu W = {0.6 * w / 1e3:.0f} kN; ground force x: max {fx.max() / 1e3:.1f} kN, mean over the "
+          f"second half {fx[late].mean() / 1e3:.1f} kN ({fx[late].mean() / (0.6 * w):.3f} mu W); track speed at the "
+          f"sprocket {float(ds.sprocket_speed[-1]) * rp:.2f} m/s against the vehicle's {float(ds.chassis_vx[-1]):.2f}")
+
+
+def step(speed=10.0):
+    """The paper's step at 10 m/s with the closed layout and the speed drive, 0.5 s."""
+    sc = tb.Scenario.from_dict({**CLOSED, "speed": speed, "drive.kind": "speed", "drive.target": speed})
+    ds = tb.simulate(sc)
+    print(f"step: {ds.attrs['status']} ({ds.attrs['status_message']}), solve {ds.attrs['solve_time']:.2f} s; peak "
+          f"sprocket torque {float(ds.peak_sprocket_torque) / 1e3:.1f} kN m at {float(ds.peak_sprocket_torque_time):.3f} s, "
+          f"peak idler force {float(ds.peak_idler_force) / 1e3:.1f} kN, peak wheel forces "
+          f"{np.round(ds.peak_wheel_force_y.values / 1e3)} kN, first obstacle contact {float(ds.first_contact_time):.4f} s")
+
+
+def cost():
+    """Wall time of paper_step with the closed layout against the paper's layout, side by
+    side, best of REPEATS (both damped, so that the figure is the layout's cost)."""
+    variants = {"paper layout": tb.Scenario.paper(preset="damped"),
+                "closed layout": tb.Scenario.from_dict({**CLOSED, "drive.kind": "speed"})}
+    for sc in variants.values():
+        tb.simulate(sc.with_overrides({"duration": 0.02}))
+    best = {k: np.inf for k in variants}
+    for _ in range(REPEATS):
+        for name, sc in variants.items():
+            t = time.perf_counter()
+            ds = tb.simulate(sc)
+            best[name] = min(best[name], time.perf_counter() - t)
+            print(f"  {name}: {time.perf_counter() - t:.2f} s wall, solve {ds.attrs['solve_time']:.2f} s, steps "
+                  f"{ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected)")
+    print(f"cost: closed / paper layout wall time {best['closed layout'] / best['paper layout']:.1f} (best of {REPEATS}; "
+          "target: at most 3)")
+
+
+PARTS = {"rest": rest, "drive": drive, "traction": traction, "step": step, "cost": cost}
+
+if __name__ == "__main__":
+    for name in sys.argv[1:] or PARTS:
+        PARTS[name]()
