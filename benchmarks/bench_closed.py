@@ -49,12 +49,45 @@ def drive(target=10.0, duration=6.0):
         span = ds.span_tension.values[late]
         rp = sc["sprocket.pitch_radius"]
         from_spans = np.nanmean(span[:, 1] - span[:, 0]) * rp
+        arms = _span_moment(ds, sc, late)
         print(f"  last 2 s: speed {v.min():.3f}-{v.max():.3f} m/s (worst {100 * np.abs(v / target - 1).max():.2f} %), "
               f"mean {v.mean():.3f}; mean torque {torque.mean() / 1e3:.3f} kN m, (lower - upper span) x r_p "
-              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %)")
+              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %), the two spans' "
+              f"tensions times their own lever arms about the axis {arms / 1e3:.3f} kN m "
+              f"({100 * (arms / torque.mean() - 1):+.1f} %)")
     print(f"  energy residual max {float(abs(ds.energy_residual).max()):.1e} of E0; drive work "
           f"{float(ds.drive_work[-1]) / 1e3:.0f} kJ, dissipated {float(ds.energy_dissipated[-1]) / 1e3:.0f} kJ")
     return ds
+
+
+def _span_moment(ds, sc, rows):
+    """Mean moment about the sprocket axis of the tensions of the two links that leave the
+    sprocket (each along its own line: a link leaving a seated pin is not tangent to the
+    pitch circle), forward positive."""
+    import json
+    cl = json.loads(ds.attrs["closed_layout"])
+    sx, sy = cl["sprocket"]
+    rp = cl["pitch_radius"]
+    th = ds.chassis_pitch.values[rows]
+    ax = ds.chassis_x.values[rows] + np.cos(th) * sx - np.sin(th) * sy
+    ay = ds.chassis_y.values[rows] + np.sin(th) * sx + np.cos(th) * sy
+    px, py = ds.pin_x.values[rows], ds.pin_y.values[rows]
+    tension = ds.link_tension.values[rows]
+    seated = np.hypot(px - ax[:, None], py - ay[:, None]) < rp + 0.5 * (cl["seat_radius"] - cl["pin_radius"]) + 1e-3
+    out = []
+    for k in range(len(th)):
+        m = 0.0
+        for b in range(px.shape[1]):      # link b: pins[b - 1] -> pins[b]
+            a, z = b - 1, b
+            if seated[k, a] == seated[k, z]:
+                continue
+            s_, f_ = (a, z) if seated[k, a] else (z, a)
+            dx, dy = px[k, f_] - px[k, s_], py[k, f_] - py[k, s_]
+            l = np.hypot(dx, dy)
+            rx, ry = px[k, s_] - ax[k], py[k, s_] - ay[k]
+            m += tension[k, b] * (rx * dy - ry * dx) / l     # CCW moment of the pull on the sprocket
+        out.append(-m)                                       # forward = clockwise
+    return float(np.mean(out))
 
 
 def traction(torque=60e3, duration=1.0):
@@ -66,11 +99,14 @@ def traction(torque=60e3, duration=1.0):
     rp = sc["sprocket.pitch_radius"]
     w = ds.attrs["weight"]
     fx = ds.ground_force_x.values
+    fy = ds.ground_force_y.values
     late = ds.time.values > 0.5 * duration
     print(f"traction: {ds.attrs['status']}, torque {torque / 1e3:.0f} kN m = {torque / rp / 1e3:.0f} kN at the pitch "
-          f"circle against mu W = {0.6 * w / 1e3:.0f} kN; ground force x: max {fx.max() / 1e3:.1f} kN, mean over the "
-          f"second half {fx[late].mean() / 1e3:.1f} kN ({fx[late].mean() / (0.6 * w):.3f} mu W); track speed at the "
-          f"sprocket {float(ds.sprocket_speed[-1]) * rp:.2f} m/s against the vehicle's {float(ds.chassis_vx[-1]):.2f}")
+          f"circle against mu W = {0.6 * w / 1e3:.0f} kN; ground force x / y at every sample at most "
+          f"{np.max(fx / np.maximum(fy, 1.0)):.4f} (mu = 0.6); over the second half mean x {fx[late].mean() / 1e3:.1f} "
+          f"kN, mean y {fy[late].mean() / 1e3:.1f} kN (x / y {fx[late].mean() / fy[late].mean():.4f}); track speed at "
+          f"the sprocket {float(ds.sprocket_speed[-1]) * rp:.2f} m/s against the vehicle's "
+          f"{float(ds.chassis_vx[-1]):.2f}")
 
 
 def step(speed=10.0):

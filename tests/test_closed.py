@@ -213,3 +213,35 @@ def test_closed_run_attributes_describe_the_layout(rest):
     cl = json.loads(ds.attrs["closed_layout"])
     assert ds.attrs["track_layout"] == "closed"
     assert cl["teeth"] == 10 and len(cl["sprocket"]) == 2
+
+
+DRIVEN = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6}
+
+
+def test_traction_limit():
+    """A drive torque above what mu x weight carries: the track slips, and the ground's
+    tractive force stays at or below mu x its normal force."""
+    sc = tb.Scenario.from_dict({**DRIVEN, "terrain": {"kind": "flat"}, "speed": 0.0, "drive.kind": "torque",
+                                "drive.torque": 60e3, "duration": 0.3, "output_interval": 1e-3})
+    assert 60e3 / sc["sprocket.pitch_radius"] > 0.6 * 230e3
+    ds = tb.simulate(sc)
+    assert ds.attrs["status"] == "completed"
+    fx, fy = ds.ground_force_x.values, ds.ground_force_y.values
+    assert np.all(fx <= 0.6 * fy * (1 + 1e-9) + 1e-6)
+    late = ds.time.values > 0.15
+    assert fx[late].mean() > 0.9 * 0.6 * fy[late].mean()          # saturated
+    slip = float(ds.sprocket_speed[-1]) * sc["sprocket.pitch_radius"] - float(ds.chassis_vx[-1])
+    assert slip > 1.0
+    assert float(abs(ds.energy_residual).max()) < 1e-6
+
+
+def test_paper_step_with_the_closed_track():
+    """The paper's step at 10 m/s with the closed layout and the speed drive: completes,
+    sprocket torque and tensioner force peaks in the summary."""
+    from trackbench.output import summary_numbers
+    ds = tb.simulate(tb.Scenario.from_dict({**DRIVEN, "drive.kind": "speed"}))
+    assert ds.attrs["status"] == "completed"
+    s = summary_numbers(ds)
+    assert s["peak_sprocket_torque_kN m"] > 0.0 and s["peak_idler_force_kN"] > 100.0
+    assert float(ds.first_contact_time) == pytest.approx(0.0568, abs=3e-3)
+    assert float(abs(ds.energy_residual).max()) < 1e-6

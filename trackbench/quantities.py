@@ -28,6 +28,7 @@ class Quantity:
     late: bool           # decided after the motion turns chaotic (first link compression):
     #                      differs by 10-60 % between correct runs, compare as a range
     summary: bool = True  # in the summary (run.json, summary.csv, one-screen summary)
+    closed: bool = False  # the closed track's only (track.layout = "closed")
 
     @property
     def per_wheel(self):
@@ -70,6 +71,10 @@ TABLE = (
     Q("min_chassis_ay", "min_chassis_ay", "peak", "m/s^2", 1.0, "min chassis vertical acceleration", "ay min",
       late=True),
     Q("min_chassis_vx", "min_chassis_vx", "peak", "m/s", 1.0, "min chassis speed", "vx min", late=True),
+    Q("peak_sprocket_torque", "peak_sprocket_torque", "peak", "kN m", 1e3, "peak drive torque on the sprocket",
+      "sprk kNm", late=True, closed=True),
+    Q("peak_idler_force", "peak_idler_force", "peak", "kN", 1e3, "peak tensioner force", "idler kN", late=True,
+      closed=True),
     Q("first_contact_time", "first_contact_time", "event", "s", 1.0, "first obstacle contact", None, late=False),
     Q("first_compression_time", "first_compression_time", "event", "s", 1.0, "first link compression", "compr s",
       late=False),
@@ -84,18 +89,21 @@ SUMMARY = tuple(q for q in TABLE if q.summary)
 PEAKS = tuple(q for q in SUMMARY if q.kind == "peak")
 
 
-def summary_columns(n_wheels, times=True):
-    """The summary's result columns in order: each peak with its _time, then the rest."""
+def summary_columns(n_wheels, times=True, closed=False):
+    """The summary's result columns in order: each peak with its _time, then the rest
+    (the closed track's own where closed)."""
     out = []
     for q in SUMMARY:
+        if q.closed and not closed:
+            continue
         for c in q.columns(n_wheels):
             out += [c, c + "_time"] if times and q.kind == "peak" else [c]
     return out
 
 
-def peak_columns(n_wheels):
+def peak_columns(n_wheels, closed=False):
     """The peaks' columns (those with replicate statistics)."""
-    return [c for q in PEAKS for c in q.columns(n_wheels)]
+    return [c for q in PEAKS if closed or not q.closed for c in q.columns(n_wheels)]
 
 
 def quantity_of(column):
@@ -114,6 +122,8 @@ def entries(ds):
     """(quantity, column, SI value, time or None) of a run's Dataset, in table order; plain
     floats, NaN kept (a run without a link compression has no first_compression_time)."""
     for q in SUMMARY:
+        if q.closed and q.variable not in ds:
+            continue
         v = ds[q.variable]
         t = ds[q.variable + "_time"] if q.kind == "peak" else None
         if q.per_wheel:

@@ -129,7 +129,7 @@ RULES = {
     "drive.kind": (str, tuple(DRIVES), None, "one of " + ", ".join(DRIVES)),
     "drive.torque": (float, -1e7, 1e7, "a number in [-1e7, 1e7] N m"),
     "drive.curve": (list, None, None, "a list of [sprocket speed rad/s, torque N m] pairs, speeds increasing, or []"),
-    "drive.target": (float, -100.0, 100.0, "a number in [-100, 100] m/s"),
+    "drive.target": (float, -100.0, 100.0, "a number in [-100, 100] m/s (default: the start speed)"),
     "drive.gain_p": _NONNEG,
     "drive.gain_i": _NONNEG,
     "drive.torque_limit": _POS,
@@ -400,7 +400,8 @@ def _check_closed(out, explicit):
                             frozenset(explicit))
     except ClosedLayoutError as e:
         raise ScenarioError(str(e)) from None
-    for name, value in g.resolved().items():
+    resolved = {**g.resolved(), "drive.target": out["speed"]}   # the speed drive holds the start speed
+    for name, value in resolved.items():
         if name not in explicit:
             set_dotted(out, name, value)
 

@@ -83,7 +83,7 @@ def closed_defaults():
             "kind": "none",               # "none" (free sprocket), "torque", "speed"
             "torque": 0.0,                # torque drive: forward torque on the sprocket (N m)
             "curve": [],                  # torque drive: [[sprocket speed rad/s, torque N m], ...] instead of torque
-            "target": 10.0,               # speed drive: chassis speed to hold (m/s)
+            "target": 10.0,               # speed drive: chassis speed to hold (m/s); default: the start speed
             "gain_p": 3.0e4,              # speed drive: PI gains (N m per m/s, N m per m)
             "gain_i": 3.0e4,
             "torque_limit": 3.0e4,        # speed drive: |torque| at most (N m)

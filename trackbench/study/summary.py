@@ -12,7 +12,7 @@ from .spec import Run, Study, load_study
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
 # the results in the study table on screen, in its column order (vertical acceleration as min, max)
 SCREEN = ("peak_wheel_force_y", "peak_ground_force_y", "peak_link_tension", "min_chassis_ay", "peak_chassis_ay",
-          "min_chassis_vx", "first_compression_time")
+          "min_chassis_vx", "first_compression_time", "peak_sprocket_torque", "peak_idler_force")
 
 
 def _wheels(study):
@@ -20,14 +20,18 @@ def _wheels(study):
     return max(n)
 
 
+def _closed(study):
+    return any(r.scenario["track"].get("layout") == "closed" for r in study.runs)
+
+
 def peak_columns(study):
     """The summary's peak columns, in summary order (replicate statistics cover these)."""
-    return Q.peak_columns(_wheels(study))
+    return Q.peak_columns(_wheels(study), _closed(study))
 
 
 def summary_frame(study):
     """One row per run of the study (pending when it has not run), from the runs' run.json."""
-    results = Q.summary_columns(_wheels(study))
+    results = Q.summary_columns(_wheels(study), closed=_closed(study))
     rows = []
     for run in study.runs:
         rec = store.read_run(study.output, run.run_id) or {"status": "pending", "status_message": ""}
