@@ -46,15 +46,14 @@ def drive(target=10.0, duration=6.0):
     if np.isfinite(reach) and reach < duration - 2.0:
         v = vx[late]
         torque = ds.sprocket_torque.values[late]
-        span = ds.span_tension.values[late]
         rp = sc["sprocket.pitch_radius"]
-        from_spans = np.nanmean(span[:, 1] - span[:, 0]) * rp
+        from_spans = np.nanmean(ds.lower_span_tension.values[late] - ds.upper_span_tension.values[late]) * rp
         arms = _span_moment(ds, sc, late)
         print(f"  last 2 s: speed {v.min():.3f}-{v.max():.3f} m/s (worst {100 * np.abs(v / target - 1).max():.2f} %), "
               f"mean {v.mean():.3f}; mean torque {torque.mean() / 1e3:.3f} kN m, (lower - upper span) x r_p "
-              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %), the two spans' "
-              f"tensions times their own lever arms about the axis {arms / 1e3:.3f} kN m "
-              f"({100 * (arms / torque.mean() - 1):+.1f} %)")
+              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %); the two leaving links' "
+              f"pulls on their seated pins, each with its own lever arm about the axis, hold back "
+              f"{-arms / 1e3:.3f} kN m ({100 * (-arms / torque.mean() - 1):+.1f} %)")
     print(f"  energy residual max {float(abs(ds.energy_residual).max()):.1e} of E0; drive work "
           f"{float(ds.drive_work[-1]) / 1e3:.0f} kJ, dissipated {float(ds.energy_dissipated[-1]) / 1e3:.0f} kJ")
     return ds

@@ -89,7 +89,7 @@ def test_rest_stays_at_rest(rest):
     assert float(abs(ds.energy_residual).max()) < 1e-6
     assert abs(float(ds.ground_force_y[-1]) - ds.attrs["weight"]) < 1e-6 * ds.attrs["weight"]
     for name in ("sprocket_angle", "sprocket_speed", "sprocket_torque", "idler_position", "idler_force",
-                 "drive_work", "span_tension", "peak_sprocket_torque", "peak_idler_force"):
+                 "drive_work", "upper_span_tension", "lower_span_tension", "peak_sprocket_torque", "peak_idler_force"):
         assert name in ds
     assert ds.pin.size == sc["track.n_links"]
 

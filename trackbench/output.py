@@ -150,6 +150,7 @@ def _closed_layout(model, result, scenario):
     pins, _, guides = _place(model, q)
     tension = d[:, L.diag_tension(nw):L.diag_tension(nw) + nl]
     pk = result.peaks
+    spans = _span_tensions(model, q, pins, tension, g)
     v = {
         "sprocket_angle": _var(T, -q[:, i_s], "rad", "sprocket angle relative to the chassis, forward (clockwise) positive"),
         "sprocket_speed": _var(T, -qd[:, i_s], "rad s-1", "sprocket speed relative to the chassis, forward positive"),
@@ -163,8 +164,8 @@ def _closed_layout(model, result, scenario):
         "idler_x": _var(T, guides[:, 0, 0], "m", "idler centre x"),
         "idler_y": _var(T, guides[:, 0, 1], "m", "idler centre y"),
         "drive_work": _var(T, y[:, 2 * nq + L.Y_DRIVE_WORK], "J", "work done by the drive on the sprocket since t = 0"),
-        "span_tension": _var(("time", "span"), _span_tensions(model, q, pins, tension, g), "N",
-                             "tension of the link leaving the sprocket: upper span, lower span"),
+        "upper_span_tension": _var(T, spans[:, 0], "N", "tension of the link leaving the sprocket upwards"),
+        "lower_span_tension": _var(T, spans[:, 1], "N", "tension of the link leaving the sprocket downwards"),
         "peak_sprocket_torque": _var((), pk[L.PK_DRIVE_TORQUE, 0], "N m", "max drive torque over all accepted steps"),
         "peak_sprocket_torque_time": _var((), pk[L.PK_DRIVE_TORQUE, 1], "s", "time of peak_sprocket_torque"),
         "peak_idler_force": _var((), pk[L.PK_IDLER_FORCE, 0], "N", "max tensioner force over all accepted steps"),
@@ -258,7 +259,6 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
                              "of the ground run")
         coords["link"] = _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1; link 0 "
                               "joins the last pin and pin 1)")
-        coords["span"] = _var(("span",), np.array(["upper", "lower"]), "1", "the spans leaving the sprocket")
         attrs.update(_closed_attrs(scenario))
     return xr.Dataset(v, coords=coords, attrs=attrs)
 
