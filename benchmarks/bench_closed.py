@@ -49,6 +49,7 @@ def drive(target=10.0, duration=6.0):
         rp = sc["sprocket.pitch_radius"]
         from_spans = np.nanmean(ds.lower_span_tension.values[late] - ds.upper_span_tension.values[late]) * rp
         arms = _span_moment(ds, sc, late)
+        print(f"  mean teeth torque {ds.teeth_torque.values[late].mean() / 1e3:.3f} kN m")
         print(f"  last 2 s: speed {v.min():.3f}-{v.max():.3f} m/s (worst {100 * np.abs(v / target - 1).max():.2f} %), "
               f"mean {v.mean():.3f}; mean torque {torque.mean() / 1e3:.3f} kN m, (lower - upper span) x r_p "
               f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %); the two leaving links' "
@@ -61,18 +62,17 @@ def drive(target=10.0, duration=6.0):
 
 def _span_moment(ds, sc, rows):
     """Mean moment about the sprocket axis of the tensions of the two links that leave the
-    sprocket (each along its own line: a link leaving a seated pin is not tangent to the
-    pitch circle), forward positive."""
+    sprocket (from the last pin that can touch the teeth to the first that cannot; each along
+    its own line, which is not tangent to the pitch circle), forward positive."""
     import json
     cl = json.loads(ds.attrs["closed_layout"])
     sx, sy = cl["sprocket"]
-    rp = cl["pitch_radius"]
     th = ds.chassis_pitch.values[rows]
     ax = ds.chassis_x.values[rows] + np.cos(th) * sx - np.sin(th) * sy
     ay = ds.chassis_y.values[rows] + np.sin(th) * sx + np.cos(th) * sy
     px, py = ds.pin_x.values[rows], ds.pin_y.values[rows]
     tension = ds.link_tension.values[rows]
-    seated = np.hypot(px - ax[:, None], py - ay[:, None]) < rp + 0.5 * (cl["seat_radius"] - cl["pin_radius"]) + 1e-3
+    seated = np.hypot(px - ax[:, None], py - ay[:, None]) < cl["tip_radius"] + cl["pin_radius"]
     out = []
     for k in range(len(th)):
         m = 0.0

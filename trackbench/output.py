@@ -119,17 +119,17 @@ _FIRST_TIMES = [  # name, peaks row, text
 
 def _span_tensions(model, q, pins, tension, g):
     """Tension of the link that leaves the sprocket upwards and of the one that leaves it
-    downwards (the first link with one pin seated on the sprocket and the other off it)."""
+    downwards (the link from the last pin that can touch the teeth, within tip radius + pin
+    radius of the axis, to the first that cannot)."""
     c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
     sx, sy = g.sprocket
     ax = q[:, L.Q_X] + c * sx - s * sy
     ay = q[:, L.Q_Y] + s * sx + c * sy
     r = np.hypot(pins[:, :, 0] - ax[:, None], pins[:, :, 1] - ay[:, None])
-    seated = r < g.pitch_radius + 0.5 * (model.arrays.loop[L.LP_SEAT_RADIUS] - model.arrays.loop[L.LP_PIN_RADIUS]) + 1e-3
+    on_teeth = r < g.tip_radius + model.arrays.loop[L.LP_PIN_RADIUS]
     # link b joins pins b and b+1 (pins numbered 1..n: link 0 joins pin n and pin 1)
-    a_seat = np.roll(seated, 1, axis=1)     # pin b (link b's first pin), column b - 1 of pins
-    b_seat = seated                         # pin b + 1
-    leaving = a_seat != b_seat
+    first = np.roll(on_teeth, 1, axis=1)    # pin b (link b's first pin), column b - 1 of pins
+    leaving = first != on_teeth             # against pin b + 1
     mid_y = 0.5 * (pins[:, :, 1] + np.roll(pins[:, :, 1], 1, axis=1))
     out = np.full((len(q), 2), np.nan)
     for k in range(len(q)):
