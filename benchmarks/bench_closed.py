@@ -52,19 +52,20 @@ def drive(target=10.0, duration=6.0):
         print(f"  mean teeth torque {ds.teeth_torque.values[late].mean() / 1e3:.3f} kN m")
         print(f"  last 2 s: speed {v.min():.3f}-{v.max():.3f} m/s (worst {100 * np.abs(v / target - 1).max():.2f} %), "
               f"mean {v.mean():.3f}; mean torque {torque.mean() / 1e3:.3f} kN m, (lower - upper span) x r_p "
-              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %); the two leaving links' "
-              f"pulls on their seated pins, each with its own lever arm about the axis, hold back "
-              f"{-arms / 1e3:.3f} kN m ({100 * (-arms / torque.mean() - 1):+.1f} %)")
+              f"{from_spans / 1e3:.3f} kN m ({100 * (from_spans / torque.mean() - 1):+.1f} %); the two spans' pulls, "
+              f"each with its own lever arm about the axis, hold back {arms / 1e3:.3f} kN m "
+              f"({100 * (arms / torque.mean() - 1):+.1f} %)")
     print(f"  energy residual max {float(abs(ds.energy_residual).max()):.1e} of E0; drive work "
           f"{float(ds.drive_work[-1]) / 1e3:.0f} kJ, dissipated {float(ds.energy_dissipated[-1]) / 1e3:.0f} kJ")
     return ds
 
 
 def _span_moment(ds, sc, rows):
-    """Mean moment about the sprocket axis of the tensions of the two links that leave the
-    sprocket (from the last pin that can touch the teeth to the first that cannot; each along
-    its own line, which is not tangent to the pitch circle), forward positive."""
+    """Mean moment about the sprocket axis of the two spans' pulls where they leave the
+    sprocket (output._span_links: the second link from the last pin on the teeth), each along
+    its own line, forward positive: what the spans hold back against the drive."""
     import json
+    from trackbench.output import _span_links
     cl = json.loads(ds.attrs["closed_layout"])
     sx, sy = cl["sprocket"]
     th = ds.chassis_pitch.values[rows]
@@ -72,20 +73,21 @@ def _span_moment(ds, sc, rows):
     ay = ds.chassis_y.values[rows] + np.sin(th) * sx + np.cos(th) * sy
     px, py = ds.pin_x.values[rows], ds.pin_y.values[rows]
     tension = ds.link_tension.values[rows]
-    seated = np.hypot(px - ax[:, None], py - ay[:, None]) < cl["tip_radius"] + cl["pin_radius"]
+    on_teeth = np.hypot(px - ax[:, None], py - ay[:, None]) < cl["tip_radius"] + cl["pin_radius"]
+    links = _span_links(on_teeth, 0.5 * (py + np.roll(py, 1, axis=1)))
     out = []
     for k in range(len(th)):
+        if links[k, 0] < 0:
+            continue
         m = 0.0
-        for b in range(px.shape[1]):      # link b: pins[b - 1] -> pins[b]
-            a, z = b - 1, b
-            if seated[k, a] == seated[k, z]:
-                continue
-            s_, f_ = (a, z) if seated[k, a] else (z, a)
-            dx, dy = px[k, f_] - px[k, s_], py[k, f_] - py[k, s_]
-            l = np.hypot(dx, dy)
-            rx, ry = px[k, s_] - ax[k], py[k, s_] - ay[k]
-            m += tension[k, b] * (rx * dy - ry * dx) / l     # CCW moment of the pull on the sprocket
-        out.append(-m)                                       # forward = clockwise
+        for b in links[k]:
+            a = b - 1                       # link b: pins[b - 1] -> pins[b]
+            toward = np.hypot(px[k, a] - ax[k], py[k, a] - ay[k]) < np.hypot(px[k, b] - ax[k], py[k, b] - ay[k])
+            near, far = (a, b) if toward else (b, a)
+            dx, dy = px[k, far] - px[k, near], py[k, far] - py[k, near]
+            rx, ry = px[k, near] - ax[k], py[k, near] - ay[k]
+            m += tension[k, b] * (rx * dy - ry * dx) / np.hypot(dx, dy)   # CCW moment of the pull on the near pin
+        out.append(m)                       # CCW = backward
     return float(np.mean(out))
 
 

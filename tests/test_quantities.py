@@ -7,19 +7,34 @@ from trackbench import output, quantities
 from trackbench.replay.plots import study_axes
 from trackbench.study.executors import run_summary
 
-SI_OF = {"kN": "N", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1"}
+SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1"}
 
 
 def test_the_table_matches_the_dataset(paper_run_short):
     """Every quantity is a Dataset variable whose SI unit its display unit converts from;
     each peak has its _time."""
-    for q in quantities.TABLE:
-        var = paper_run_short[q.variable]
+    _check_table(paper_run_short, [q for q in quantities.TABLE if not q.closed])
+    assert not any(q.variable in paper_run_short for q in quantities.TABLE if q.closed)
+
+
+def _check_table(ds, table):
+    for q in table:
+        var = ds[q.variable]
         assert var.attrs["units"] == SI_OF[q.unit], q.variable
         assert var.dims == (("wheel",) if q.per_wheel else ()), q.variable
         assert q.kind in ("peak", "event", "check")
         if q.kind == "peak":
-            assert paper_run_short[q.variable + "_time"].attrs["units"] == "s"
+            assert ds[q.variable + "_time"].attrs["units"] == "s"
+
+
+def test_the_closed_track_quantities_match_its_dataset():
+    import trackbench as tb
+    ds = tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "duration": 2e-3, "speed": 0.0}))
+    _check_table(ds, quantities.TABLE)
+    cols = [c for q, c, _, _ in quantities.entries(ds)]
+    assert "peak_sprocket_torque" in cols and "peak_idler_force" in cols
+    assert "peak_sprocket_torque" in quantities.summary_columns(5, closed=True)
+    assert "peak_sprocket_torque" not in quantities.summary_columns(5)
 
 
 def test_summary_columns_in_the_documented_order():

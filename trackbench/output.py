@@ -117,26 +117,37 @@ _FIRST_TIMES = [  # name, peaks row, text
 ]
 
 
+def _span_links(on_teeth, mid_y):
+    """Per sample, the links of the upper and the lower span one link away from the sprocket:
+    the link after the one from the last pin that can touch the teeth (that one's pull still
+    depends on where its pin sits on a flank). Pins in array order; link b joins pins[b - 1]
+    and pins[b] (link 0: the last pin and the first)."""
+    n = on_teeth.shape[1]
+    out = np.full((on_teeth.shape[0], 2), -1)
+    for k in range(on_teeth.shape[0]):
+        t = on_teeth[k]
+        ends = [b for b in range(n) if t[b - 1] != t[b]]
+        if len(ends) != 2:
+            continue
+        spans = [(b + 1) % n if t[b - 1] else (b - 1) % n for b in ends]   # one link further away
+        up = int(np.argmax([mid_y[k, b] for b in spans]))
+        out[k] = spans[up], spans[1 - up]
+    return out
+
+
 def _span_tensions(model, q, pins, tension, g):
-    """Tension of the link that leaves the sprocket upwards and of the one that leaves it
-    downwards (the link from the last pin that can touch the teeth, within tip radius + pin
-    radius of the axis, to the first that cannot)."""
+    """Tension of the upper and of the lower span where they leave the sprocket (_span_links;
+    NaN where the loop does not leave the teeth at exactly two places)."""
     c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
     sx, sy = g.sprocket
     ax = q[:, L.Q_X] + c * sx - s * sy
     ay = q[:, L.Q_Y] + s * sx + c * sy
     r = np.hypot(pins[:, :, 0] - ax[:, None], pins[:, :, 1] - ay[:, None])
     on_teeth = r < g.tip_radius + model.arrays.loop[L.LP_PIN_RADIUS]
-    # link b joins pins b and b+1 (pins numbered 1..n: link 0 joins pin n and pin 1)
-    first = np.roll(on_teeth, 1, axis=1)    # pin b (link b's first pin), column b - 1 of pins
-    leaving = first != on_teeth             # against pin b + 1
     mid_y = 0.5 * (pins[:, :, 1] + np.roll(pins[:, :, 1], 1, axis=1))
-    out = np.full((len(q), 2), np.nan)
-    for k in range(len(q)):
-        idx = np.flatnonzero(leaving[k])
-        if idx.size >= 2:
-            up, down = idx[np.argmax(mid_y[k, idx])], idx[np.argmin(mid_y[k, idx])]
-            out[k] = tension[k, up], tension[k, down]
+    links = _span_links(on_teeth, mid_y)
+    rows = np.arange(len(q))[:, None]
+    out = np.where(links >= 0, tension[rows, np.maximum(links, 0)], np.nan)
     return out
 
 
@@ -164,8 +175,9 @@ def _closed_layout(model, result, scenario):
         "idler_x": _var(T, guides[:, 0, 0], "m", "idler centre x"),
         "idler_y": _var(T, guides[:, 0, 1], "m", "idler centre y"),
         "drive_work": _var(T, y[:, 2 * nq + L.Y_DRIVE_WORK], "J", "work done by the drive on the sprocket since t = 0"),
-        "upper_span_tension": _var(T, spans[:, 0], "N", "tension of the link leaving the sprocket upwards"),
-        "lower_span_tension": _var(T, spans[:, 1], "N", "tension of the link leaving the sprocket downwards"),
+        "upper_span_tension": _var(T, spans[:, 0], "N", "tension of the upper span where it leaves the sprocket "
+                                   "(the second link from the last pin on the teeth)"),
+        "lower_span_tension": _var(T, spans[:, 1], "N", "tension of the lower span where it leaves the sprocket"),
         "peak_sprocket_torque": _var((), pk[L.PK_DRIVE_TORQUE, 0], "N m", "max drive torque over all accepted steps"),
         "peak_sprocket_torque_time": _var((), pk[L.PK_DRIVE_TORQUE, 1], "s", "time of peak_sprocket_torque"),
         "peak_idler_force": _var((), pk[L.PK_IDLER_FORCE, 0], "N", "max tensioner force over all accepted steps"),
