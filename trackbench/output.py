@@ -186,6 +186,36 @@ def _closed_layout(model, result, scenario):
     return v
 
 
+def _soil(model, result, ground, scenario):
+    """Soft soil: each pin's sinkage below the soil surface (the ground's profile, along the
+    normal of the segment under it), the rut at the end of the run (the plastic sinkage each
+    cell of the soil's memory keeps)."""
+    par, rut = model.par, model.arrays.rut
+    nq = model.nq
+    q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
+    pins, _, _ = _place(model, q)
+    px, py = pins[:, :, 0], pins[:, :, 1]
+    seg = ground.segments
+    k = np.clip(np.searchsorted(seg[:, L.SEG_X0], px, side="right") - 1, 0, len(seg) - 1)
+    s = (px - seg[k, L.SEG_X0]) * seg[k, L.SEG_NX] + (py - seg[k, L.SEG_Y0]) * seg[k, L.SEG_NY]
+    sink = np.maximum(par[L.P_PAD_GROUND] - s, 0.0)
+    x = par[L.P_RUT_X0] + (np.arange(rut.size) + 0.5) * par[L.P_RUT_DX]
+    plastic = np.maximum(rut - par[L.P_SOIL_K] * rut ** par[L.P_SOIL_N] / par[L.P_SOIL_KE], 0.0)
+    used = np.flatnonzero(rut > 0.0)
+    lo, hi = (used[0], used[-1] + 1) if used.size else (0, 0)
+    v = {"drawbar_pull": _var(T, d[:, L.D_GROUND_FX], "N", "net horizontal force of the ground (soil shear and "
+                              "pressure) on the track: thrust minus the soil's resistance")}
+    if model.closed:
+        track = -qd[:, L.q_sprocket(model.nw, model.n_links)] * model.arrays.loop[L.LP_PITCH_RADIUS]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            slip = np.where(np.abs(track) > 1e-3, 1.0 - qd[:, L.Q_X] / track, np.nan)
+        v["slip"] = _var(T, slip, "1", "slip: 1 - chassis speed / (sprocket speed x pitch radius)")
+    return {**v, "sinkage": _var(P, sink, "m", "pin's sinkage below the soil surface (0 off the soil)"),
+            "rut_depth": _var(("rut_x",), plastic[lo:hi], "m", "plastic sinkage the soil keeps at the end of "
+                              "the run (the rut), along x"),
+            "rut_max_sinkage": _var(("rut_x",), rut[lo:hi], "m", "deepest sinkage reached, along x")}, x[lo:hi]
+
+
 def _closed_attrs(scenario):
     from .simulate import closed_parts
     g, lp, guides = closed_parts(scenario)
@@ -257,6 +287,10 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
         v.update(_closed_layout(model, result, scenario))
+    rut_x = None
+    if model.par[L.P_SOIL] != 0.0:
+        soil_vars, rut_x = _soil(model, result, ground, scenario)
+        v.update(soil_vars)
     for name, (dims, data, units, text) in result.extra.items():
         v[name] = _var(dims, data, units, text)
     coords = {
@@ -272,6 +306,8 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
         coords["link"] = _var(("link",), np.arange(nl), "1", "track link number (joins pins b and b+1; link 0 "
                               "joins the last pin and pin 1)")
         attrs.update(_closed_attrs(scenario))
+    if rut_x is not None:
+        coords["rut_x"] = _var(("rut_x",), rut_x, "m", "x of the soil's memory cells (centres)")
     return xr.Dataset(v, coords=coords, attrs=attrs)
 
 

@@ -108,6 +108,7 @@ RULES = {
     "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
     "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
     "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
+    "track.width": (float, 0.0, 10.0, "a number in (0, 10] m"),
     "sprocket.position": (str, ("rear", "front"), None, "one of rear, front"),
     "sprocket.teeth": (int, 3, 60, "an integer in [3, 60]"),
     "sprocket.pitch_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived from the link pitch)"),
@@ -141,7 +142,7 @@ RULES = {
     "record.enabled": (bool, None, None, "true or false"),
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }
-_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent",
+_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent", "track.width",
              "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed",
              "contact.friction_velocity"} | {
     k for k, r in RULES.items() if r is _POS}
@@ -155,6 +156,7 @@ TERRAIN_RULES = {
     "gap": (float, 0.0, 1000.0, "a number in [0, 1000] m"),
     "points": (list, None, None, "a list of [x, y] pairs with x non-decreasing"),
     "obstacles": (list, None, None, "a list of obstacle tables"),
+    "soil": (str, None, None, "rigid, a soil name (trackbench params) or a table of soil values"),
 }
 _TERRAIN_KEYS = {
     "flat": set(),
@@ -287,6 +289,20 @@ def _validate_obstacle(ob, where, first):
 
 
 def validate_terrain(t):
+    """The terrain table: its shape (_terrain_shape) and, on any shape, terrain.soil."""
+    soil = t.get("soil", "rigid")
+    out = _terrain_shape({k: v for k, v in t.items() if k != "soil"})
+    if soil != "rigid":
+        from .model.soil import resolve_soil
+        try:
+            resolve_soil(soil)
+        except ValueError as e:
+            raise ScenarioError(str(e)) from None
+        out["soil"] = soil
+    return out
+
+
+def _terrain_shape(t):
     kind = _check_value("terrain.kind", t.get("kind"), TERRAIN_RULES["kind"])
     if kind == "flat":
         extra = set(t) - {"kind"}
@@ -507,6 +523,7 @@ def _check_extensions(d, explicit):
             ("contact.law", c["law"] != "linear"), ("contact.damping", c["damping"] != "none"),
             ("contact.geometry", c["geometry"] != "paper"), ("contact.friction", c["friction"] > 0),
             ("track.link_damping", d["track"]["link_damping"] > 0),
+            ("terrain.soil", d["terrain"].get("soil", "rigid") != "rigid"),
             ("vehicle.arm_damping", any(a > 0 for a in arms))) if on]
         if ext:
             raise ScenarioError(f"solver = 'lee' runs the paper's model only, but {ext[0]} is set; "

@@ -21,8 +21,8 @@ from .scenario import Scenario
 @functools.lru_cache(maxsize=32)
 def _equilibrium_cached(key):
     from .model.equilibrium import solve_equilibrium
-    vehicle, track, gravity, contact = json.loads(key)
-    return solve_equilibrium(vehicle, track, gravity, contact)
+    vehicle, track, gravity, contact, soil = json.loads(key)
+    return solve_equilibrium(vehicle, track, gravity, contact, {int(k): v for k, v in soil.items()})
 
 
 def _closed(scenario):
@@ -51,19 +51,20 @@ def closed_parts(scenario: Scenario):
 
 
 @functools.lru_cache(maxsize=32)
-def _loop_equilibrium_cached(key):
+def _loop_equilibrium_cached(key, soil):
     from .model.equilibrium import solve_loop_equilibrium
     vehicle, track, gravity, contact, *_ = json.loads(key)
     g, lp, guides = _closed_parts_cached(key)
-    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, lp, guides)
+    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, lp, guides,
+                                  {int(k): v for k, v in json.loads(soil).items()})
 
 
 def equilibrium(scenario: Scenario):
     """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
     if _closed(scenario):
-        return _loop_equilibrium_cached(_closed_key(scenario))
-    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"]],
-                     sort_keys=True)
+        return _loop_equilibrium_cached(_closed_key(scenario), json.dumps(soil_par(scenario)))
+    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"],
+                      soil_par(scenario)], sort_keys=True)
     return _equilibrium_cached(key)
 
 
@@ -105,6 +106,41 @@ def initial_state(scenario: Scenario, eq):
     return y0
 
 
+RUT_CELL = 0.01          # m: the soil's memory, one value per cell along x
+RUT_CELLS_MAX = 2_000_000
+
+
+def soil_par(scenario):
+    """{P_* index: value} of the scenario's soft soil, {} on rigid ground."""
+    from .model.soil import resolve_soil
+    soil = resolve_soil(scenario["terrain"].get("soil", "rigid"))
+    if soil is None:
+        return {}
+    b = scenario["track.width"]
+    area = b * scenario["track.link_length"]
+    return {L.P_SOIL: 1.0, L.P_SOIL_N: soil["n"], L.P_SOIL_K: soil["k_c"] / b + soil["k_phi"],
+            L.P_SOIL_KE: soil["unloading_stiffness"], L.P_PIN_AREA: area, L.P_SOIL_COHESION: soil["cohesion"] * area,
+            L.P_SOIL_TAN_PHI: float(np.tan(np.radians(soil["friction_angle"]))),
+            L.P_SOIL_SHEAR_K: soil["shear_modulus"]}
+
+
+def _soil(scenario, eq, par):
+    """Soft soil's values into par and its memory cells, over where the track can go in the
+    run; None on rigid ground."""
+    values = soil_par(scenario)
+    if not values:
+        return None
+    for k, v in values.items():
+        par[k] = v
+    x = eq.info["pins"][:, 0]
+    reach = abs(scenario["speed"]) * scenario["duration"] * 2.0 + 5.0
+    lo, hi = x.min() - reach, x.max() + reach
+    dx = max(RUT_CELL, (hi - lo) / RUT_CELLS_MAX)
+    par[L.P_RUT_X0] = lo
+    par[L.P_RUT_DX] = dx
+    return np.zeros(int(np.ceil((hi - lo) / dx)))
+
+
 class Model:
     """One scenario's vehicle and ground as the compiled kernels take them: the bundles
     of model/bundles.py, and the sizes and figures the Python side needs."""
@@ -118,7 +154,9 @@ class Model:
         parts = closed_parts(scenario)
         self.closed = parts is not None
         loop, guides = (parts[1], parts[2]) if self.closed else (None, None)
-        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides)
+        rut = _soil(scenario, eq, par)
+        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides,
+                                   rut)
         self.work = work_arrays(self.arrays, self.nw, self.n_links)
         self.weight = eq.weight if self.closed else total_mass(v, tr) * scenario["gravity"]
         self.nq = L.n_coordinates(self.nw, self.n_links, self.closed)

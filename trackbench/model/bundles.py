@@ -26,6 +26,10 @@ ModelArrays = namedtuple("ModelArrays", [
     "pins",       # int (N_PN,) which pin rows are free, PN_*
     "loop",       # (N_LOOP,) sprocket, tensioner and drive of the closed layout, LP_*; empty for the paper's
     "guides",     # (n_guides, N_G_COLS) idler (row 0) and support rollers, G_*; no rows for the paper's
+    "rut",        # (n_cells,) the soil's memory: deepest sinkage reached in each cell along x (m);
+                  # empty on rigid ground (P_RUT_X0, P_RUT_DX place the cells)
+    "touchdown",  # (n_pins, 2) where each pin last touched the soil (NaN: off it), for its shear
+                  # displacement; no rows on rigid ground
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -42,6 +46,7 @@ Work = namedtuple("Work", [
     "pair_seen",  # int (rows, width - 1): the evaluation (C_EVALUATIONS) that last found the pair
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
+    "sink",       # (n_pins,) each pin's sinkage into soft soil at the last evaluation (m; 0 off it)
 ])
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
@@ -57,9 +62,10 @@ def arm_table(pivots, phi0, damping):
     return arms
 
 
-def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None):
+def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None, rut=None):
     """The bundle, with empty candidate lists (marked stale: built at the first use).
-    loop and guides: the closed layout's (LP_*, G_*); None for the paper's."""
+    loop and guides: the closed layout's (LP_*, G_*); rut: soft soil's memory cells; None
+    for the paper's layout and rigid ground."""
     n_wheels = arms.shape[0]
     closed = loop is not None
     guides = np.zeros((0, L.N_G_COLS)) if guides is None else guides
@@ -75,7 +81,9 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None)
                        np.array(rows, dtype=np.int64), ref, np.zeros(L.N_COUNTERS, dtype=np.int64),
                        np.zeros((nbr.shape[0], nbr.shape[1] - 1)), pins,
                        np.ascontiguousarray(loop if closed else np.zeros(0), dtype=float),
-                       np.ascontiguousarray(guides, dtype=float).reshape(-1, L.N_G_COLS))
+                       np.ascontiguousarray(guides, dtype=float).reshape(-1, L.N_G_COLS),
+                       np.zeros(0) if rut is None else np.ascontiguousarray(rut, dtype=float),
+                       np.full((0 if rut is None else n_links + 1, 2), np.nan))
 
 
 def work_arrays(m, n_wheels, n_links):
@@ -85,7 +93,7 @@ def work_arrays(m, n_wheels, n_links):
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
             np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
-            np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape))
+            np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins))
     if not closed:
         return Work(*base)
     ng = m.guides.shape[0]

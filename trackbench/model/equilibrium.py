@@ -70,14 +70,17 @@ class Equilibrium:
 class _Problem:
     """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins)."""
 
-    def __init__(self, vehicle, track, gravity, contact=None):
+    def __init__(self, vehicle, track, gravity, contact=None, soil=None):
         self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
+        for k, v in (soil or {}).items():    # soft soil: fresh (no memory cells), every pin loading
+            self.par[k] = v
         self.nw = int(vehicle["n_wheels"])
         self.n_links = int(track["n_links"])
         self.phi = equilibrium_arm_angle(vehicle)
         self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
         g = flat_ground()
-        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links)
+        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links,
+                              rut=np.zeros(0) if soil else None)
         self.work = work_arrays(self.m, self.nw, self.n_links)
         self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
         self.nq = L.n_coordinates(self.nw, self.n_links)
@@ -232,6 +235,29 @@ def _levenberg_marquardt(P, u, target, max_iter):
     return u, np.abs(r).max(), it
 
 
+def _rounded(P, u, norm, it, target, max_iter):
+    """Where Newton's method stalled (a contact opening under its step, soft soil's infinite
+    stiffness at the surface for n < 1): Levenberg-Marquardt steps, then Newton again."""
+    for _ in range(4):
+        if norm <= target:
+            break
+        u, norm, k = _levenberg_marquardt(P, u, target, 20)
+        it += k
+        u, norm, k = _newton(P, u, target, max_iter)
+        it += k
+    return u, norm, it
+
+
+def _soil_sinkage(P, pins):
+    """A first guess of the sinkage into soft soil: the weight spread evenly over the pins
+    of the ground run (0 on rigid ground)."""
+    if P.par[L.P_SOIL] == 0.0:
+        return 0.0
+    on_ground = max(int(np.sum(pins[:, 1] < pins[:, 1].min() + 0.01)), 1)
+    p = P.weight / (on_ground * P.par[L.P_PIN_AREA])
+    return (p / P.par[L.P_SOIL_K]) ** (1.0 / P.par[L.P_SOIL_N])
+
+
 def _continuation(P, u, target, max_iter, step=0.05):
     """Newton's method, for a power law F = k delta^n (no stiffness at zero compression,
     where Newton's method starts) through a chain of laws k d^(n - m) delta^m, m from 1 to
@@ -253,10 +279,11 @@ def _continuation(P, u, target, max_iter, step=0.05):
     return u, norm, it
 
 
-def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_iter=60):
-    """Newton's method from the wheels resting on the track and the track on the ground.
-    A power law is reached by continuation (_continuation)."""
-    P = _Problem(vehicle, track, gravity, contact)
+def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=1e-12, max_iter=60):
+    """Newton's method from the wheels resting on the track and the track on the ground
+    (soil: {P_* index: value} of soft soil, simulate.soil_par). A power law is reached by
+    continuation (_continuation)."""
+    P = _Problem(vehicle, track, gravity, contact, soil)
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
     hg = P.par[L.P_PAD_GROUND]
     # start: wheels resting on the track, the track on the ground, chassis level
@@ -265,8 +292,11 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, tol_rel=1e-12, max_
     ends_w = P.ends + [0.0, yc]
     pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
     u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
+    u[0] -= _soil_sinkage(P, pins)
+    u[3::2] -= _soil_sinkage(P, pins)
     target = tol_rel * P.weight
     u, norm, it = _continuation(P, u, target, max_iter)
+    u, norm, it = _rounded(P, u, norm, it, target, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
         raise EquilibriumError(
             f"static equilibrium not found: force residual {norm:.3g} N after {it} Newton "
@@ -296,15 +326,18 @@ class _LoopProblem(_Problem):
     vanishes; Newton's method does not find that point reliably: the loop's cogging
     energy is not smooth)."""
 
-    def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides):
+    def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides, soil=None):
         from .closed import loop_pins
         self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
+        for k, v in (soil or {}).items():
+            self.par[k] = v
         self.nw = int(vehicle["n_wheels"])
         self.n_links = geometry.n_links
         self.phi = equilibrium_arm_angle(vehicle)
         self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
         g = flat_ground()
-        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links, loop, guides)
+        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links, loop, guides,
+                              np.zeros(0) if soil else None)
         self.work = work_arrays(self.m, self.nw, self.n_links)
         self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
         self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
@@ -388,21 +421,16 @@ def _loop_residual(u, phi, psi, free, m, w, diag, r, arm_moment):
     return w.genf[L.Q_X]
 
 
-def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, guides, tol_rel=1e-12, max_iter=60):
+def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12,
+                           max_iter=60):
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
     taut loop (model/closed.py) resting on the ground, the sprocket held."""
-    P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides)
+    P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides, soil)
     yc = -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND]     # the loop's lowest pins resting on the ground
     u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
     target = tol_rel * P.weight
     u, norm, it = _continuation(P, u, target, max_iter)
-    for _ in range(4):           # a stall at an opening contact: round it by LM, then Newton again
-        if norm <= target:
-            break
-        u, norm, k = _levenberg_marquardt(P, u, target, 20)
-        it += k
-        u, norm, k = _newton(P, u, target, max_iter)
-        it += k
+    u, norm, it = _rounded(P, u, norm, it, target, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
         raise EquilibriumError(
             f"static equilibrium of the closed track not found: force residual {norm:.3g} N after {it} Newton "

@@ -17,12 +17,13 @@ from ..status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 from .gaps import (ground_distance, link_frames, pin_cap_weight, pin_ground_selection, pin_segment_valid, point_on_link,
                    point_on_segment, segment_coords)
 from .contact_force import friction, normal_force
+from .soil_force import pin_on_soil, soil_shear
 from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
     LK_LENGTH, LK_TX, LK_TY,
-    G_REACH, K_GUIDE_LINK, K_GUIDE_PIN, PN_LAST,
+    G_REACH, K_GUIDE_LINK, K_GUIDE_PIN, PN_LAST, P_PIN_AREA, P_SOIL,
     C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_FRICTION, P_FRICTION_VELOCITY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 
@@ -376,13 +377,14 @@ def wheel_contacts(w, m, diag, mem):
 
 
 @njit(**INLINE)
-def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, acc):
+def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection); in the continuous geometry one
     contact per pin with the ground's nearest point (gaps.ground_distance). acc = (fx,
     fy, corner force, energy, power, obstacle force, dissipation), carried through in
     the order of one loop. Every segment after the first (the ground the vehicle starts
-    on) belongs to an obstacle."""
+    on) belongs to an obstacle. soil = (rut memory, sinkage out): on soft soil a pin sunk by
+    z = h_g - s takes the soil's pressure times its area instead of the pad spring."""
     law = contact_law(par, P_C_GROUND)
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
@@ -391,9 +393,13 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, acc):
     v_eps = par[P_FRICTION_VELOCITY]
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
+    on_soil = par[P_SOIL] != 0.0
+    rut, touchdown, sink = soil
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, last + 1):
         row = first + b
+        if on_soil:
+            sink[b] = 0.0
         if continuous:
             inside, n_below, best = False, 0, 0.0
         else:
@@ -415,11 +421,20 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, acc):
                     continue
             if s >= hg:
                 continue
-            rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
-            p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
+            fr = (mu, v_eps)
+            if on_soil:     # Bekker pressure, Janosi-Hanamoto shear instead of Coulomb friction
+                p = pin_on_soil(apos[b, 0], hg - s, par, rut) * par[P_PIN_AREA]
+                e, pd = 0.0, 0.0
+                sink[b] = max(sink[b], hg - s)
+                ft = soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], (ny, -nx), p, par)
+                force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
+                fr = (0.0, v_eps)
+            else:
+                rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
+                p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
+                force = (p * nx, p * ny, p, e, pd)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
-            acc = _push_pin(fpin, avel, b, (p * nx, p * ny, p, e, pd), (0.0, 0.0), (ny, -nx), (mu, v_eps), acc,
-                            (0.0, p if sj > 0 else 0.0))
+            acc = _push_pin(fpin, avel, b, force, (0.0, 0.0), (ny, -nx), fr, acc, (0.0, p if sj > 0 else 0.0))
             gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     return gx, gy, corner_force, energy, power, obstacle, dissipation
 
@@ -444,6 +459,7 @@ def _corners(w, m, diag, mem, acc):
 def ground_contacts(w, m, diag, mem):
     """The track against the ground: pins on segments, then the corners."""
     acc = _pins_on_ground(w.apos, w.avel, w.fpin, m.pins[PN_LAST], m.par, m.seg, m.nbr, m.nbr_rows, mem,
+                          (m.rut, m.touchdown, w.sink),
                           (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     gx, gy, corner_force, energy, power, obstacle, dissipation = _corners(w, m, diag, mem, acc)
     diag[D_E_PAD_GROUND] = energy

@@ -258,7 +258,18 @@ P_LINK_DAMPING = 24      # axial dashpot of every link (N s/m)
 P_CONTACT_GEOMETRY = 25   # GEOMETRY_* code (contact_laws.py)
 P_FRICTION = 26          # Coulomb coefficient mu between ground and track
 P_FRICTION_VELOCITY = 27  # regularising speed of the friction law (m/s)
-N_PAR = 28
+# soft soil (model/soil_force.py; 0 in P_SOIL: the rigid ground of the paper)
+P_SOIL = 28              # 1: pins press on Bekker soil instead of the ground pads
+P_SOIL_N = 29            # Bekker exponent n
+P_SOIL_K = 30            # k_c / b + k_phi (N/m^(n+2))
+P_SOIL_KE = 31           # unloading / reloading stiffness K_e (Pa/m)
+P_PIN_AREA = 32          # ground area one pin stands for: track width x link length (m^2)
+P_RUT_X0 = 33            # x of the first cell of the soil's memory (m)
+P_RUT_DX = 34            # cell width (m)
+P_SOIL_COHESION = 35     # cohesion x the pin's area, c A (N)
+P_SOIL_TAN_PHI = 36      # tan of the soil's friction angle
+P_SOIL_SHEAR_K = 37      # shear deformation modulus K of Janosi-Hanamoto (m)
+N_PAR = 38
 
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point

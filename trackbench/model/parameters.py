@@ -48,6 +48,7 @@ def paper_track():
         "link_damping": 0.0,              # axial dashpot parallel to each link spring (N s/m)
         "layout": "paper",                # "paper": ends fixed to the chassis; "closed": a loop (closed.py)
         "tension": 80000.0,               # closed layout: static tension the derived link count and preload aim at (N)
+        "width": 0.5,                     # b: soft soil's pressure acts over this width (m; the paper gives none)
     }
 
 
