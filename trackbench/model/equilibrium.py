@@ -426,7 +426,7 @@ def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, gui
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
     taut loop (model/closed.py) resting on the ground, the sprocket held."""
     P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides, soil)
-    yc = -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND]     # the loop's lowest pins resting on the ground
+    yc = -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND] - _soil_sinkage(P, P.pins)   # lowest pins on the ground
     u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
     target = tol_rel * P.weight
     u, norm, it = _continuation(P, u, target, max_iter)
