@@ -3,6 +3,7 @@
 import tomllib
 from pathlib import Path
 
+from .model.soil import SOIL_CHOICES
 from .presets import PRESETS, preset_values
 from .scenario import RULES, Scenario, ScenarioError, flatten, paper_step
 
@@ -118,6 +119,8 @@ def parameter_table():
         rows.append(f"{k:32s} {str(base.get(k, '')):>16s}  {rule[3]}")
     rows.append("terrain.kind                     step              flat, step, ramp, block, bump, points, sequence")
     rows.append("terrain.height / length / position / first_contact_time / gap / points / obstacles: see README")
+    rows.append("terrain.soil                     rigid             rigid, " + ", ".join(SOIL_CHOICES[1:])
+                + ", or a table (docs/usage.md)")
     for name in PRESETS:
         if name == "paper":
             continue
