@@ -279,6 +279,31 @@ def _continuation(P, u, target, max_iter, step=0.05):
     return u, norm, it
 
 
+def _solve(P, u, max_iter, tol_rel, failure, check):
+    """Newton's method (by continuation for a power law), rounded where it stalls; the
+    solution and the iteration count, or EquilibriumError above 1e-6 of the weight."""
+    target = tol_rel * P.weight
+    u, norm, it = _continuation(P, u, target, max_iter)
+    u, norm, it = _rounded(P, u, norm, it, target, max_iter)
+    if not np.isfinite(norm) or norm > 1e-6 * P.weight:
+        raise EquilibriumError(f"{failure}: force residual {norm:.3g} N after {it} Newton iterations (needs < "
+                               f"{1e-6 * P.weight:.3g} N); check {check}")
+    return u, it
+
+
+def _balance(P, u):
+    """At the solution: residuals, coordinates, the torsion bars' free angles and preloads
+    (the torsion torque -k_t (phi - phi0) balances each arm's moment about its pivot), pins,
+    wheel loads, wheel centres and link tensions."""
+    r, fx, arm_moment = P.residual(u)
+    q = P.q_of(u)
+    preload = -arm_moment
+    phi0 = q[L.Q_ARM:L.Q_ARM + P.nw] + preload / P.par[L.P_TORSION_STIFFNESS]
+    apos, fpin, fwheel, wc = P.loads(q)
+    tension = P.diag[L.diag_tension(P.nw):L.diag_tension(P.nw) + P.n_links].copy()
+    return r, fx, arm_moment, q, phi0, preload, apos, fwheel, wc, tension
+
+
 def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=1e-12, max_iter=60):
     """Newton's method from the wheels resting on the track and the track on the ground
     (soil: {P_* index: value} of soft soil, simulate.soil_par). A power law is reached by
@@ -294,21 +319,8 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
     u[0] -= _soil_sinkage(P, pins)
     u[3::2] -= _soil_sinkage(P, pins)
-    target = tol_rel * P.weight
-    u, norm, it = _continuation(P, u, target, max_iter)
-    u, norm, it = _rounded(P, u, norm, it, target, max_iter)
-    if not np.isfinite(norm) or norm > 1e-6 * P.weight:
-        raise EquilibriumError(
-            f"static equilibrium not found: force residual {norm:.3g} N after {it} Newton "
-            f"iterations (needs < {1e-6 * P.weight:.3g} N); check the vehicle and track geometry")
-    r, fx, arm_moment = P.residual(u)
-    q = P.q_of(u)
-    kt = P.par[L.P_TORSION_STIFFNESS]
-    # torsion torque -k_t (phi - phi0) balances the arm's moment about its pivot
-    preload = -arm_moment
-    phi0 = q[L.Q_ARM:L.Q_ARM + P.nw] + preload / kt
-    apos, fpin, fwheel, wc = P.loads(q)
-    tension = P.diag[L.diag_tension(P.nw):L.diag_tension(P.nw) + P.n_links].copy()
+    u, it = _solve(P, u, max_iter, tol_rel, "static equilibrium not found", "the vehicle and track geometry")
+    r, fx, arm_moment, q, phi0, preload, apos, fwheel, wc, tension = _balance(P, u)
     return Equilibrium(
         q=q, phi0=phi0, preload=preload, wheel_load=fwheel[:, 1].copy(), tension=tension,
         ground_force=float(P.diag[L.D_GROUND_FY]), weight=P.weight,
@@ -428,19 +440,9 @@ def solve_loop_equilibrium(vehicle, track, gravity, contact, geometry, loop, gui
     P = _LoopProblem(vehicle, track, gravity, contact, geometry, loop, guides, soil)
     yc = -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND] - _soil_sinkage(P, P.pins)   # lowest pins on the ground
     u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
-    target = tol_rel * P.weight
-    u, norm, it = _continuation(P, u, target, max_iter)
-    u, norm, it = _rounded(P, u, norm, it, target, max_iter)
-    if not np.isfinite(norm) or norm > 1e-6 * P.weight:
-        raise EquilibriumError(
-            f"static equilibrium of the closed track not found: force residual {norm:.3g} N after {it} Newton "
-            f"iterations (needs < {1e-6 * P.weight:.3g} N); check the sprocket, idler and track values")
-    r, fx, arm_moment = P.residual(u)
-    q = P.q_of(u)
-    preload = -arm_moment
-    phi0 = q[L.Q_ARM:L.Q_ARM + P.nw] + preload / P.par[L.P_TORSION_STIFFNESS]
-    apos, fpin, fwheel, wc = P.loads(q)
-    tension = P.diag[L.diag_tension(P.nw):L.diag_tension(P.nw) + P.n_links].copy()
+    u, it = _solve(P, u, max_iter, tol_rel, "static equilibrium of the closed track not found",
+                   "the sprocket, idler and track values")
+    r, fx, arm_moment, q, phi0, preload, apos, fwheel, wc, tension = _balance(P, u)
     w = P.work
     return Equilibrium(
         q=q, phi0=phi0, preload=preload, wheel_load=fwheel[:, 1].copy(), tension=tension,

@@ -39,7 +39,7 @@ from .layout import (
     SP_ANGLE, SP_FX, SP_FY, SP_RATE, SP_TORQUE, SP_VX, SP_VY, SP_X, SP_Y, Y_DISSIPATED, Y_DRIVE_INTEGRAL,
     Y_DRIVE_WORK, Y_WORK,
 )
-from .reduced import chassis_acceleration, chassis_and_arms, pin_accelerations
+from .reduced import chassis_acceleration, chassis_and_arms, pin_accelerations, take_out_rows
 from .sprocket import pin_on_sprocket
 
 @njit(**INLINE)
@@ -242,29 +242,6 @@ def _idler(q, qd, m, w, c, s, force):
 
 
 @njit(**INLINE)
-def _schur_rows(extra, a, f):
-    """Take the sprocket's and the idler's rows out of the chassis block (as the arms')."""
-    s00, s01, s02, s11, s12, s22 = a
-    r0, r1, r2 = f
-    for r in range(extra.shape[0]):
-        bx = extra[r, ARM_BX]
-        by = extra[r, ARM_BY]
-        bt = extra[r, ARM_BT]
-        d = extra[r, ARM_D]
-        gq = extra[r, ARM_Q]
-        s00 -= bx * bx / d
-        s01 -= bx * by / d
-        s02 -= bx * bt / d
-        s11 -= by * by / d
-        s12 -= by * bt / d
-        s22 -= bt * bt / d
-        r0 -= bx * gq / d
-        r1 -= by * gq / d
-        r2 -= bt * gq / d
-    return (s00, s01, s02, s11, s12, s22), (r0, r1, r2)
-
-
-@njit(**INLINE)
 def _forces_at_rest(f, w, nw, n, genf):
     """The generalised forces (no inertia terms at rest) for the static equilibrium."""
     genf[Q_X], genf[Q_Y], genf[Q_PITCH] = f
@@ -306,7 +283,7 @@ def loop_rhs(y, m, w, ydot, diag):
     f = (f[0] + df[0], f[1] + df[1], f[2] + df[2])
     _forces_at_rest(f, w, nw, n, w.genf)
     d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]
-    a, f = _schur_rows(w.extra, a, f)
+    a, f = take_out_rows(w.extra, 0.0, ARM_D, a, f)   # the sprocket's and the idler's rows
     ax, ay, at = chassis_acceleration(w.arm, d, a, f)
     for k in range(nq):
         ydot[k] = qd[k]

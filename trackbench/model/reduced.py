@@ -99,25 +99,35 @@ def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
 
 
 @njit(**INLINE)
+def take_out_rows(rows, d, col_d, a, f):
+    """The Schur complement's part of rows that couple with the chassis alone (arms, the
+    closed track's sprocket and idler): A - sum B_i B_i^T / d_i and f - sum B_i Q_i / d_i,
+    d_i = d, or rows[i, col_d] where col_d >= 0."""
+    s00, s01, s02, s11, s12, s22 = a
+    r0, r1, r2 = f
+    for i in range(rows.shape[0]):
+        bx = rows[i, ARM_BX]
+        by = rows[i, ARM_BY]
+        bt = rows[i, ARM_BT]
+        qa = rows[i, ARM_Q]
+        di = rows[i, col_d] if col_d >= 0 else d
+        s00 -= bx * bx / di
+        s01 -= bx * by / di
+        s02 -= bx * bt / di
+        s11 -= by * by / di
+        s12 -= by * bt / di
+        s22 -= bt * bt / di
+        r0 -= bx * qa / di
+        r1 -= by * qa / di
+        r2 -= bt * qa / di
+    return (s00, s01, s02, s11, s12, s22), (r0, r1, r2)
+
+
+@njit(**INLINE)
 def chassis_acceleration(arm, d, a, f):
     """(ax, ay, alpha) of the chassis: the Schur complement S = A - sum B_i B_i^T / d and
     its right side, solved by cofactors (3x3 symmetric). d: the arms' diagonal mass."""
-    s00, s01, s02, s11, s12, s22 = a
-    r0, r1, r2 = f
-    for i in range(arm.shape[0]):
-        bx = arm[i, ARM_BX]
-        by = arm[i, ARM_BY]
-        bt = arm[i, ARM_BT]
-        qa = arm[i, ARM_Q]
-        s00 -= bx * bx / d
-        s01 -= bx * by / d
-        s02 -= bx * bt / d
-        s11 -= by * by / d
-        s12 -= by * bt / d
-        s22 -= bt * bt / d
-        r0 -= bx * qa / d
-        r1 -= by * qa / d
-        r2 -= bt * qa / d
+    (s00, s01, s02, s11, s12, s22), (r0, r1, r2) = take_out_rows(arm, d, -1, a, f)
     c00 = s11 * s22 - s12 * s12
     c01 = s02 * s12 - s01 * s22
     c02 = s01 * s12 - s02 * s11
