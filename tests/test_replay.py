@@ -367,3 +367,86 @@ def test_closed_configuration_png(closed_run, tmp_path):
     # sprocket face (pale blue), idler guide (bronze bar), track tension colours (green)
     assert share("#c9d3e6") > 0.001 and share("#b4783c") > 0.0001
     assert share("#%02x%02x%02x" % tuple(G.TENSION_RGB[2].astype(int)), 0.06) > 0.001
+
+
+# ---------------------------------------------------------------------------- soft soil ----
+
+@pytest.fixture(scope="module")
+def soil_run():
+    """A short paper-layout run on dry sand: the track sinks and leaves a rut."""
+    return tb.simulate(tb.Scenario.from_dict({"terrain.soil": "dry_sand", "duration": 0.05}))
+
+
+@pytest.fixture(scope="module")
+def soil_recording(soil_run, tmp_path_factory):
+    return R.write_recording(soil_run, tmp_path_factory.mktemp("soil") / "recording.rrd", every=4)
+
+
+def test_soil_recording_logs_the_deformed_surface(soil_run, soil_recording):
+    ds = soil_run
+    data = read_temporal(soil_recording)
+    assert R.E_SOIL in data and R.E_SOIL in static_entities(soil_recording)
+    idx = R.frame_indices(ds.sizes["time"], 4)
+    np.testing.assert_allclose(seconds(data[R.E_SOIL][R.TIMELINE]), ds["time"].values[idx], atol=1e-9)
+    strips = np.array(data[R.E_SOIL]["LineStrips2D:strips"], dtype=float)[:, 0]      # (n, m, 2), y negated
+    assert strips.shape[0] == len(idx)
+    x, height = strips[-1, :, 0], -strips[:, :, 1]
+    assert np.all(np.diff(x) >= 0)
+    # the last frame: the original ground lowered by rut_depth at each cell centre (flat soil at y = 0)
+    rx, depth = ds["rut_x"].values, ds["rut_depth"].values
+    assert depth.max() > 0.01
+    at = np.searchsorted(x, rx[depth > 0] - 1e-6)
+    np.testing.assert_allclose(x[at], rx[depth > 0], atol=1e-5)
+    np.testing.assert_allclose(height[-1, at], -depth[depth > 0], atol=1e-5)
+    # the surface only ever sinks; it ends the run deeper than it started
+    assert np.all(np.diff(height, axis=0) <= 1e-6)
+    assert height[-1].min() < height[0].min() - 1e-3 or np.sum(height[-1] < -1e-3) > np.sum(height[0] < -1e-3)
+    # away from the rut it is the ground
+    ground = G.ground_polyline(ds)
+    np.testing.assert_allclose(strips[-1, [0, -1]] * [1, -1], ground[[0, -1]], atol=1e-5)
+
+
+def test_soil_dent_matches_an_independent_rebuild(soil_run):
+    """The dent: the running maximum of the pins' sinkage binned into the rut cells, scaled per
+    cell to end at rut_depth; without the scaling it ends within the sampling's reach of
+    rut_max_sinkage."""
+    ds = soil_run
+    rx, depth = ds["rut_x"].values, ds["rut_depth"].values
+    dx = rx[1] - rx[0]
+    n = ds.sizes["time"]
+    hist, last = G.running_sinkage(ds, np.arange(n), np.append(rx - dx / 2, rx[-1] + dx / 2))
+    cells = np.floor((ds["pin_x"].values - (rx[0] - dx / 2)) / dx).astype(int)
+    want = np.zeros((n, rx.size))
+    for i in range(n):
+        for c, s in zip(cells[i], ds["sinkage"].values[i]):
+            if 0 <= c < rx.size and s > 0:
+                want[i, c] = max(want[i, c], s, want[i - 1, c] if i else 0.0)
+        if i:
+            want[i] = np.maximum(want[i], want[i - 1])
+    np.testing.assert_allclose(hist, want, atol=1e-12)
+    np.testing.assert_allclose(last, want[-1])
+    assert np.abs(last - ds["rut_max_sinkage"].values).max() < 0.01
+    base, drop = G.soil_surface(ds, [0, n - 1])
+    at = np.searchsorted(base[:, 0], rx[depth > 0] - 1e-9)
+    np.testing.assert_allclose(drop[-1, at], depth[depth > 0], atol=1e-12)
+    assert np.all(drop[0] <= drop[-1] + 1e-12)
+
+
+def test_rigid_runs_log_no_soil(run_folder, step_run):
+    assert not G.is_soil(step_run)
+    rrd = run_folder / "recording.rrd"
+    assert R.E_SOIL not in read_temporal(rrd) and R.E_SOIL not in static_entities(rrd)
+
+
+def test_soil_configuration_png_shows_the_rut(soil_run, step_run, tmp_path):
+    import matplotlib.image as mpimg
+    from trackbench.replay.plots import SOIL_DENT, plot_configuration
+
+    def share(path):
+        img = mpimg.imread(path)[..., :3]
+        rgb = np.array([int(SOIL_DENT[k:k + 2], 16) for k in (1, 3, 5)]) / 255
+        return np.all(np.abs(img - rgb) < 0.03, axis=-1).mean()
+
+    soil = plot_configuration(soil_run, (0.0, 0.05), tmp_path / "soil.png")
+    rigid = plot_configuration(step_run, (0.0, 0.1), tmp_path / "rigid.png")
+    assert share(soil) > 0.0005 and share(rigid) == 0.0

@@ -14,6 +14,7 @@ from . import geometry as G
 
 DEFAULT_TIMES = (0.1, 0.35, 0.45)
 DPI = 130
+SOIL_DENT = "#f2dc9b"   # soft soil: the rut, between the original surface and the dent
 
 
 def _plt():
@@ -87,7 +88,17 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False):
                    max(pins[:, 0].max(), g["chassis"][0][:, 0].max()) + 0.4)
     ground = G.ground_polyline(ds, (x_range[0] - 1.0, x_range[1] + 1.0))
     y_floor = float(ground[:, 1].min()) - 0.25
-    ax.add_patch(Polygon(np.vstack([ground, [[ground[-1, 0], -50.0], [ground[0, 0], -50.0]]]),
+    surface = ground
+    if G.is_soil(ds):
+        # soft soil: the ground lowered by the rut made up to this frame (geometry.soil_surface);
+        # the soil pressed out of the way (between the original surface and the dent) is pale
+        # sand under a dashed line at the original surface
+        base, drop = G.soil_surface(ds, [i], (x_range[0] - 1.0, x_range[1] + 1.0))
+        surface = base - np.stack([np.zeros_like(drop[0]), drop[0]], axis=-1)
+        ax.fill_between(base[:, 0], base[:, 1], surface[:, 1], facecolor=SOIL_DENT, edgecolor="none", zorder=1.1)
+        ax.plot(ground[:, 0], ground[:, 1], color="#785528", lw=0.8, ls=(0, (4, 3)), zorder=1.2)
+        y_floor = min(y_floor, float(surface[:, 1].min()) - 0.25)
+    ax.add_patch(Polygon(np.vstack([surface, [[surface[-1, 0], -50.0], [surface[0, 0], -50.0]]]),
                          closed=True, facecolor="#d8c3a0", edgecolor="#785528", hatch="///", lw=1.2, zorder=1))
     ax.add_patch(Polygon(g["chassis"][0][:-1], closed=True, facecolor="#e9edf2", edgecolor="#3c3c3c", lw=1.5, zorder=2))
     for (px, py), (wx, wy) in zip(g["pivots"][0], wheels):
@@ -176,10 +187,12 @@ def plot_configuration(ds, times, path):
         cx = 0.5 * (float(ds["pin_x"].values[i].min()) + float(ds["pin_x"].values[i].max()))
         draw_configuration(ax, ds, i, x_range=(cx - width / 2, cx + width / 2))
     _tension_colorbar(fig, list(axes))
+    soil = ("\nsoft soil: the rut made up to each time (pale sand) below the original surface (dashed)"
+            if G.is_soil(ds) else "")
     parts = ("\nclosed track: sprocket with its teeth (blue, the line marks its turn), "
              "idler on its guide (bronze bar), support rollers" if G.is_closed(ds) else "")
     fig.suptitle(f"{_name(ds)}: configuration (cf. Figs. 8-10); arrows: wheel-track force on the wheels (red), "
-                 f"total ground force (purple), 1 m = {1e-3 / G.FORCE_SCALE:.0f} kN{_status_note(ds)}{parts}",
+                 f"total ground force (purple), 1 m = {1e-3 / G.FORCE_SCALE:.0f} kN{_status_note(ds)}{parts}{soil}",
                  fontsize=9.5)
     fig.savefig(path, dpi=DPI)
     plt.close(fig)

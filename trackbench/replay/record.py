@@ -33,6 +33,7 @@ RECORDING_NAME = "recording.rrd"
 PLAYBACK_SPEED = 0.05  # the viewer replays at 1/20 of real time: 0.5 s simulated takes 10 s
 
 E_GROUND = "/world/ground"
+E_SOIL = "/world/ground/soil"                   # soft soil only: the surface lowered by the rut so far
 E_CHASSIS = "/world/chassis"
 E_ARMS = "/world/arms"
 E_WHEELS = "/world/wheels"
@@ -63,6 +64,7 @@ ENERGY_SERIES = (("kinetic", "energy_kinetic", (0, 114, 178)),
 CHASSIS_RGB = (60, 60, 60)
 ARM_RGB = (110, 110, 110)
 GROUND_RGB = (120, 85, 40)
+SOIL_RGB = (215, 170, 60)
 WHEEL_FORCE_RGB = (200, 0, 0)
 GROUND_FORCE_RGB = (150, 60, 200)
 SPROCKET_RGB = (40, 60, 110)
@@ -293,6 +295,9 @@ def _log_static(rec, ds):
     rec.log(E_SOLVER, rr.TextDocument(solver_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
     if G.is_closed(ds):
         _log_closed_static(rec, ds)
+    if G.is_soil(ds):
+        rec.log(E_SOIL, rr.LineStrips2D.from_fields(colors=[SOIL_RGB], radii=[0.01],
+                                                    labels=["soil surface (rut so far)"]), static=True)
 
 
 def _log_signals(rec, ds, every=1):
@@ -410,6 +415,10 @@ def _log_frames(rec, ds, idx):
         _xy32(centre[:, 0] - gx, centre[:, 1] - gy, out=g_origin[b])
         _xy32(gx, gy, out=g_vector[b])
     strips = rr.LineStrips2D.descriptor_strips()
+    if G.is_soil(ds):   # the deformed soil surface: the ground lowered by the rut so far
+        base, drop = G.soil_surface(ds, idx)
+        surface = _xy32(np.broadcast_to(base[:, 0], drop.shape), base[:, 1] - drop)
+        send(E_SOIL, indexes=t, columns=[_Column(strips, _list(_strip_values(surface), n, 1))])
     send(E_CHASSIS, indexes=t, columns=[_Column(strips, _list(_strip_values(chassis), n, 1))])
     send(E_ARMS, indexes=t, columns=[_Column(strips, _list(_strip_values(arms.reshape(n * nw, 2, 2)), n, nw))])
     wheels = np.ascontiguousarray(arms[:, :, 1])
