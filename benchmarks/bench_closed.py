@@ -11,6 +11,7 @@ import time
 import numpy as np
 
 import trackbench as tb
+from side_by_side import best_walls
 
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6}
 REPEATS = 3
@@ -125,16 +126,7 @@ def cost():
     side, best of REPEATS (both damped, so that the figure is the layout's cost)."""
     variants = {"paper layout": tb.Scenario.paper(preset="damped"),
                 "closed layout": tb.Scenario.from_dict({**CLOSED, "drive.kind": "speed"})}
-    for sc in variants.values():
-        tb.simulate(sc.with_overrides({"duration": 0.02}))
-    best = {k: np.inf for k in variants}
-    for _ in range(REPEATS):
-        for name, sc in variants.items():
-            t = time.perf_counter()
-            ds = tb.simulate(sc)
-            best[name] = min(best[name], time.perf_counter() - t)
-            print(f"  {name}: {time.perf_counter() - t:.2f} s wall, solve {ds.attrs['solve_time']:.2f} s, steps "
-                  f"{ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected)")
+    best = best_walls(variants, REPEATS)
     print(f"cost: closed / paper layout wall time {best['closed layout'] / best['paper layout']:.1f} (best of {REPEATS}; "
           "target: at most 3)")
 

@@ -4,27 +4,18 @@ REPEATS), and the closed, speed-driven track on each soil. Prints figures; asser
     python benchmarks/bench_soil.py
 """
 
-import time
 
 import numpy as np
 
 import trackbench as tb
+from side_by_side import best_walls
 
 REPEATS = 3
 
 
 def cost():
     variants = {"rigid": tb.Scenario.paper(), "lete_sand": tb.Scenario.paper(**{"terrain.soil": "lete_sand"})}
-    for sc in variants.values():
-        tb.simulate(sc.with_overrides({"duration": 0.02}))
-    best = {k: np.inf for k in variants}
-    for _ in range(REPEATS):
-        for name, sc in variants.items():
-            t = time.perf_counter()
-            ds = tb.simulate(sc)
-            best[name] = min(best[name], time.perf_counter() - t)
-            print(f"  {name}: {time.perf_counter() - t:.2f} s wall, steps {ds.attrs['steps']} "
-                  f"(+{ds.attrs['rejected_steps']} rejected), {ds.attrs['status']}")
+    best = best_walls(variants, REPEATS)
     print(f"cost: paper_step on LETE sand / rigid ground wall time {best['lete_sand'] / best['rigid']:.2f} "
           f"(best of {REPEATS}; target: at most 2)")
 

@@ -39,12 +39,12 @@ def _place(model, q):
     return pins, wheels, None
 
 
-def _motion(model, result):
-    """Chassis, arms, wheels and pins, placed by the kernels' own kinematics."""
+def _motion(model, result, placed):
+    """Chassis, arms, wheels and pins (placed: _place's, the kernels' own kinematics)."""
     nw, nl, n = model.nw, model.n_links, len(result.time)
     nq = model.nq
     q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
-    pins, wheels, _ = _place(model, q)
+    pins, wheels, _ = placed
     wheel_f = d[:, L.D_WHEEL:L.D_WHEEL + 2 * nw].reshape(n, nw, 2)
     return {
         "chassis_x": _var(T, q[:, L.Q_X], "m", "chassis mass-centre x"),
@@ -151,14 +151,14 @@ def _span_tensions(model, q, pins, tension, g):
     return out
 
 
-def _closed_layout(model, result, scenario):
+def _closed_layout(model, result, scenario, placed):
     """The closed layout's own variables: sprocket, idler, drive, span tensions."""
     from .simulate import closed_parts
     g = closed_parts(scenario)[0]
     nw, nl, nq = model.nw, model.n_links, model.nq
     q, qd, d, y = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag, result.y
     i_s, i_i = L.q_sprocket(nw, nl), L.q_idler(nw, nl)
-    pins, _, guides = _place(model, q)
+    pins, _, guides = placed
     tension = d[:, L.diag_tension(nw):L.diag_tension(nw) + nl]
     pk = result.peaks
     spans = _span_tensions(model, q, pins, tension, g)
@@ -186,14 +186,14 @@ def _closed_layout(model, result, scenario):
     return v
 
 
-def _soil(model, result, ground, scenario):
+def _soil(model, result, ground, placed):
     """Soft soil: each pin's sinkage below the soil surface (the ground's profile, along the
     normal of the segment under it), the rut at the end of the run (the plastic sinkage each
     cell of the soil's memory keeps)."""
     par, rut = model.par, model.arrays.rut
     nq = model.nq
-    q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
-    pins, _, _ = _place(model, q)
+    qd, d = result.y[:, nq:2 * nq], result.diag
+    pins, _, _ = placed
     px, py = pins[:, :, 0], pins[:, :, 1]
     seg = ground.segments
     k = np.clip(np.searchsorted(seg[:, L.SEG_X0], px, side="right") - 1, 0, len(seg) - 1)
@@ -282,14 +282,15 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     """The Dataset of one run. Solvers hand over arrays; solver-specific ones come in
     result.extra as (dims, data, units, long_name)."""
     nw, nl = model.nw, model.n_links
-    v = _motion(model, result)
+    placed = _place(model, result.y[:, :model.nq])
+    v = _motion(model, result, placed)
     v.update(_energies(result, model.nq))
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
-        v.update(_closed_layout(model, result, scenario))
+        v.update(_closed_layout(model, result, scenario, placed))
     rut_x = None
     if model.par[L.P_SOIL] != 0.0:
-        soil_vars, rut_x = _soil(model, result, ground, scenario)
+        soil_vars, rut_x = _soil(model, result, ground, placed)
         v.update(soil_vars)
     for name, (dims, data, units, text) in result.extra.items():
         v[name] = _var(dims, data, units, text)

@@ -334,9 +334,8 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
 class _LoopProblem(_Problem):
     """The closed layout at rest: unknowns u = (y_c, pitch, idler slide, sprocket angle,
     every pin), the arms at the equilibrium angle, the sprocket held by the drive at the
-    angle that seats the pins (free = 1 would let it turn to where the teeth's torque
-    vanishes; Newton's method does not find that point reliably: the loop's cogging
-    energy is not smooth)."""
+    angle that seats the pins (where a free sprocket's teeth torque would vanish, Newton's
+    method does not find reliably: the loop's cogging energy is not smooth)."""
 
     def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides, soil=None):
         from .closed import loop_pins
@@ -355,7 +354,6 @@ class _LoopProblem(_Problem):
         self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
         self.pins, self.psi = loop_pins(geometry)
         self.slide0 = geometry.slide
-        self.free = 0   # the spec's equilibrium: the sprocket held by the drive (a free one: docs/model.md)
         self.weight = (total_mass(vehicle, track) + track["pin_mass"] + loop[L.LP_IDLER_MASS]) * gravity
 
     def q_of(self, u):
@@ -369,7 +367,7 @@ class _LoopProblem(_Problem):
         return q
 
     def _args(self):
-        return self.phi, self.psi, self.free, self.m, self.work, self.diag
+        return self.phi, self.psi, self.m, self.work, self.diag
 
     def residual(self, u):
         r = np.empty(u.size)
@@ -384,7 +382,7 @@ class _LoopProblem(_Problem):
 
 
 @njit(**KERNEL)
-def _loop_jacobian(u, h, phi, psi, free, m, w, diag, J):
+def _loop_jacobian(u, h, phi, psi, m, w, diag, J):
     """Central finite differences of _loop_residual (compiled: ~270 residuals a step)."""
     n = u.shape[0]
     rp = np.empty(n)
@@ -393,9 +391,9 @@ def _loop_jacobian(u, h, phi, psi, free, m, w, diag, J):
     up = u.copy()
     for k in range(n):
         up[k] = u[k] + h
-        _loop_residual(up, phi, psi, free, m, w, diag, rp, am)
+        _loop_residual(up, phi, psi, m, w, diag, rp, am)
         up[k] = u[k] - h
-        _loop_residual(up, phi, psi, free, m, w, diag, rm, am)
+        _loop_residual(up, phi, psi, m, w, diag, rm, am)
         up[k] = u[k]
         for i in range(n):
             v = (rp[i] - rm[i]) / (2.0 * h)
@@ -403,10 +401,10 @@ def _loop_jacobian(u, h, phi, psi, free, m, w, diag, J):
 
 
 @njit(**KERNEL)
-def _loop_residual(u, phi, psi, free, m, w, diag, r, arm_moment):
+def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
     """The closed layout's generalised forces at rest (loop.loop_rhs fills w.genf) on the
-    unknowns into r (on the sprocket angle: its torque if it turns freely, else the angle's
-    change, which holds it), each arm's moment about its pivot; returns the horizontal force."""
+    unknowns into r (on the sprocket angle: its change, which holds it), each arm's moment
+    about its pivot; returns the horizontal force."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
     nq = w.genf.shape[0]
@@ -425,7 +423,7 @@ def _loop_residual(u, phi, psi, free, m, w, diag, r, arm_moment):
     r[0] = w.genf[L.Q_Y]
     r[1] = w.genf[L.Q_PITCH]
     r[2] = w.genf[q_idler(nw, n)]
-    r[3] = w.genf[q_sprocket(nw, n)] if free else u[3] - psi
+    r[3] = u[3] - psi     # held by the drive
     for k in range(2 * n):
         r[4 + k] = w.genf[off + k]
     for i in range(nw):

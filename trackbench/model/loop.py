@@ -30,8 +30,8 @@ from .jit import BORROW, INLINE, KERNEL
 from .kernels import _probe_on_track, contact_law, ground_contacts, link_tensions, refresh_neighbours, wheel_contacts
 from .kinematics import body_offset, place_wheels, wheel_velocities
 from .layout import (
-    C_EVALUATIONS, D_CHASSIS_AX, D_CHASSIS_AY, D_DISSIPATION, D_DRIVE_TORQUE, D_E_GRAVITY, D_E_KINETIC,
-    D_E_PAD_WHEEL, D_E_TORSION, D_IDLER_FORCE, D_POWER, D_STATUS, D_TEETH_TORQUE, G_BX, G_BY, G_REACH,
+    C_EVALUATIONS, D_DISSIPATION, D_DRIVE_TORQUE,
+    D_E_PAD_WHEEL, D_IDLER_FORCE, D_POWER, D_STATUS, D_TEETH_TORQUE, G_BX, G_BY, G_REACH,
     K_GUIDE_LINK, K_GUIDE_PIN, LP_TRAVEL, P_C_WHEEL, P_CONTACT_GEOMETRY, LP_GUIDE_X, LP_GUIDE_Y, LP_IDLER_MASS, LP_PRELOAD, LP_SPROCKET_INERTIA,
     LP_SPROCKET_X, LP_SPROCKET_Y, LP_TENSIONER_DAMPING, LP_TENSIONER_STIFFNESS, LP_TOOTH_DAMPING,
     LP_TOOTH_STIFFNESS, P_ARM_INERTIA, P_ARM_LENGTH, P_ARM_MASS, P_CONTACT_EXPONENT, P_CONTACT_LAW,
@@ -39,7 +39,8 @@ from .layout import (
     SP_ANGLE, SP_FX, SP_FY, SP_RATE, SP_TORQUE, SP_VX, SP_VY, SP_X, SP_Y, Y_DISSIPATED, Y_DRIVE_INTEGRAL,
     Y_DRIVE_WORK, Y_WORK,
 )
-from .reduced import chassis_acceleration, chassis_and_arms, pin_accelerations, take_out_rows
+from .reduced import (chassis_acceleration, chassis_and_arms, pin_accelerations, row_acceleration, start_rates,
+                      store_state_energies, take_out_rows)
 from .sprocket import pin_on_sprocket
 
 @njit(**INLINE)
@@ -284,19 +285,12 @@ def loop_rhs(y, m, w, ydot, diag):
     _forces_at_rest(f, w, nw, n, w.genf)
     d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]
     a, f = take_out_rows(w.extra, 0.0, ARM_D, a, f)   # the sprocket's and the idler's rows
-    ax, ay, at = chassis_acceleration(w.arm, d, a, f)
-    for k in range(nq):
-        ydot[k] = qd[k]
-    acc = ydot[nq:2 * nq]
-    acc[Q_X] = ax
-    acc[Q_Y] = ay
-    acc[Q_PITCH] = at
-    arm = w.arm
+    acc3 = chassis_acceleration(w.arm, d, a, f)
+    acc = start_rates(ydot, qd, nq, acc3)
     for i in range(nw):
-        acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
-    ex = w.extra
+        acc[Q_ARM + i] = row_acceleration(w.arm, i, d, acc3)
     for r, k in ((LOOP_SPROCKET, i_spr), (LOOP_IDLER, i_idl)):
-        acc[k] = (ex[r, ARM_Q] - ex[r, ARM_BX] * ax - ex[r, ARM_BY] * ay - ex[r, ARM_BT] * at) / ex[r, ARM_D]
+        acc[k] = row_acceleration(w.extra, r, w.extra[r, ARM_D], acc3)
     ke, e_grav = pin_accelerations(par, nw, n, w.apos, w.avel, w.fpin, acc, ke + ke_idler, e_grav + eg_idler)
     for b in range(1, n + 1):   # pins at rest: their forces for the equilibrium
         k = q_pin(nw, b)
@@ -309,11 +303,7 @@ def loop_rhs(y, m, w, ydot, diag):
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
     ydot[2 * nq + Y_DRIVE_WORK] = drive_power
     ydot[2 * nq + Y_DRIVE_INTEGRAL] = d_integral
-    diag[D_E_KINETIC] = ke
-    diag[D_E_TORSION] = e_tors
-    diag[D_E_GRAVITY] = e_grav
-    diag[D_CHASSIS_AX] = ax
-    diag[D_CHASSIS_AY] = ay
+    store_state_energies(diag, (ke, e_tors, e_grav), acc3[0], acc3[1])
     diag[D_DRIVE_TORQUE] = tau
     diag[D_IDLER_FORCE] = tension_force
     diag[D_TEETH_TORQUE] = -w.spr[SP_TORQUE]

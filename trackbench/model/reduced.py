@@ -153,6 +153,33 @@ def pin_accelerations(par, nw, last, apos, avel, fpin, acc, ke, e_grav):
     return ke, e_grav
 
 
+@njit(**INLINE)
+def start_rates(ydot, qd, nq, acc3):
+    """ydot's first part, q' = qd, and the chassis accelerations (ax, ay, alpha) into its
+    second; returns the accelerations' view."""
+    for k in range(nq):
+        ydot[k] = qd[k]
+    acc = ydot[nq:2 * nq]
+    acc[Q_X], acc[Q_Y], acc[Q_PITCH] = acc3
+    return acc
+
+
+@njit(**INLINE)
+def row_acceleration(rows, i, d, acc3):
+    """Acceleration of the coordinate of row i (an arm, the sprocket, the idler) that couples
+    with the chassis alone: (Q_i - B_i . (ax, ay, alpha)) / d_i."""
+    ax, ay, at = acc3
+    return (rows[i, ARM_Q] - rows[i, ARM_BX] * ax - rows[i, ARM_BY] * ay - rows[i, ARM_BT] * at) / d
+
+
+@njit(**INLINE)
+def store_state_energies(diag, energies, ax, ay):
+    """Kinetic, torsion and gravity energy and the chassis acceleration into diag."""
+    diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_GRAVITY] = energies
+    diag[D_CHASSIS_AX] = ax
+    diag[D_CHASSIS_AY] = ay
+
+
 @njit(**BORROW)
 def reduced_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for y = (q, qd, W, D); fills diag (forces, energies, status)."""
@@ -166,22 +193,13 @@ def reduced_rhs(y, m, w, ydot, diag):
     a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s,
                                                 _track_ends(q, par, apos, fpin))
     d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal
-    ax, ay, at = chassis_acceleration(arm, d, a, f)
-    for k in range(nq):
-        ydot[k] = qd[k]
-    acc = ydot[nq:2 * nq]
-    acc[Q_X] = ax
-    acc[Q_Y] = ay
-    acc[Q_PITCH] = at
+    acc3 = chassis_acceleration(arm, d, a, f)
+    acc = start_rates(ydot, qd, nq, acc3)
     for i in range(arm.shape[0]):
-        acc[Q_ARM + i] = (arm[i, ARM_Q] - arm[i, ARM_BX] * ax - arm[i, ARM_BY] * ay - arm[i, ARM_BT] * at) / d
+        acc[Q_ARM + i] = row_acceleration(arm, i, d, acc3)
     ke, e_tors, e_grav = e
     ke, e_grav = pin_accelerations(par, arms.shape[0], apos.shape[0] - 2, apos, avel, fpin, acc, ke, e_grav)
     diag[D_DISSIPATION] += arm_dissipation
     ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation  # dW/dt: contact forces and dampers
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
-    diag[D_E_KINETIC] = ke
-    diag[D_E_TORSION] = e_tors
-    diag[D_E_GRAVITY] = e_grav
-    diag[D_CHASSIS_AX] = ax
-    diag[D_CHASSIS_AY] = ay
+    store_state_energies(diag, (ke, e_tors, e_grav), acc3[0], acc3[1])

@@ -44,7 +44,3 @@ def _contact_switch(y0, f0, y1, f1, h, m, w, ev):
         return lambda y0, f0, y1, f1, h, m, w, ev: 2.0
     return lambda y0, f0, y1, f1, h, m, w, ev: first_contact_switch(y0, f0, y1, f1, h, m, ev)
 
-
-def is_closed(w):
-    """True where w is the closed layout's scratch (plain Python)."""
-    return isinstance(w, LoopWork)

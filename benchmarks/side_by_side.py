@@ -1,0 +1,25 @@
+"""Wall times of scenarios run side by side: the variants alternate round after round (so
+that a busy spell of this shared machine hits them alike), each figure the best of `repeats`."""
+
+import time
+
+import numpy as np
+
+import trackbench as tb
+
+
+def best_walls(variants, repeats):
+    """{name: best whole-call wall time (s)} of {name: Scenario}; each variant compiled and
+    loaded first (a 0.02 s run), every run printed."""
+    for sc in variants.values():
+        tb.simulate(sc.with_overrides({"duration": 0.02}))
+    best = {k: np.inf for k in variants}
+    for _ in range(repeats):
+        for name, sc in variants.items():
+            t = time.perf_counter()
+            ds = tb.simulate(sc)
+            wall = time.perf_counter() - t
+            best[name] = min(best[name], wall)
+            print(f"  {name}: {wall:.2f} s wall, solve {ds.attrs['solve_time']:.2f} s, steps {ds.attrs['steps']} "
+                  f"(+{ds.attrs['rejected_steps']} rejected), {ds.attrs['status']}")
+    return best
