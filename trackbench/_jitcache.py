@@ -5,16 +5,19 @@ of the functions it calls and inlines: after an upgrade (or a `git pull` on an e
 install) that changed only `model/kernels.py`, the cached time loop would still hold the
 old contact kernels. So the cache lives in a folder named by a hash of the source of the
 compiled code (model/, solvers/, status.py): ~/.cache/trackbench/numba/<hash>; the last
-few folders are kept. Setting NUMBA_CACHE_DIR yourself overrides this.
+few folders are kept, and any folder used within a day (another install may be running
+from it). Setting NUMBA_CACHE_DIR yourself overrides this.
 """
 
 import hashlib
 import os
 import shutil
 import sys
+import time
 from pathlib import Path
 
 KEEP = 3
+IDLE = 24 * 3600     # s: a folder another install (another venv, a work tree) used lately is kept
 COMPILED = ("model", "solvers")     # every @njit function lives here
 CONSTANTS = ("status.py",)          # module constants the kernels compile in
 
@@ -33,12 +36,28 @@ def configure():
     try:
         target.mkdir(parents=True, exist_ok=True)
         os.utime(target)
-        old = sorted((p for p in base.iterdir() if p.is_dir() and p != target),
-                     key=lambda p: p.stat().st_mtime, reverse=True)[KEEP - 1:]
-        for p in old:
-            shutil.rmtree(p, ignore_errors=True)
     except OSError:
         return  # not writable: numba falls back to __pycache__ / its own rules
+    try:
+        _prune(base, target)
+    except OSError:
+        pass    # pruning is housekeeping: never a reason to run without the cache
     os.environ["NUMBA_CACHE_DIR"] = str(target)
     if "numba" in sys.modules:  # already imported (by the user): set its live config too
         sys.modules["numba"].config.CACHE_DIR = str(target)
+
+
+def _prune(base, target):
+    """Remove the folders of older sources: beyond the KEEP most recent, and only once
+    unused for IDLE seconds, since another process (another install of another version)
+    may be loading from one of them right now."""
+    def age(p):
+        try:
+            return p.stat().st_mtime
+        except OSError:     # removed meanwhile by another process
+            return None
+    now = time.time()
+    folders = [(t, p) for p in base.iterdir() if p.is_dir() and p != target for t in [age(p)] if t is not None]
+    for t, p in sorted(folders, reverse=True)[KEEP - 1:]:
+        if now - t > IDLE:
+            shutil.rmtree(p, ignore_errors=True)

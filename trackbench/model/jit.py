@@ -24,3 +24,45 @@ SCALAR = KERNEL
 # half of the lee solver's time). Without the runtime (NRT) no counts are kept: such a
 # function must not create an array.
 BORROW = dict(KERNEL, _nrt=False)
+
+
+def _copy_inlined_ir_once():
+    """Compile time: numba (0.68 and before, numba issue 8989) copies a function's IR for
+    each place it is inlined one block at a time, each block with a fresh deepcopy memo,
+    so every block drags along its own copy of the function's whole variable scope: the
+    work grows with blocks x variables, and inlining the contact kernels into the
+    right-hand sides spent about a quarter of the cold start copying scopes. Here the
+    blocks copied within one inlining share one memo, so the scope (shared by all blocks
+    of the original, as numba's own inliner asserts) is copied once. Same IR, same machine
+    code (the golden tests compare results bit for bit); nothing else in numba changes."""
+    import copy
+    from numba.core import inline_closurecall as icc, ir
+
+    worker = getattr(icc, "InlineWorker", None)
+    if worker is None or getattr(icc, "copy", None) is not copy or getattr(worker, "_trackbench_shared", False):
+        return      # another numba layout: leave it alone
+
+    class _SharedMemoCopy:
+        memos = None    # {id(scope): memo} while an inlining runs
+
+        def deepcopy(self, x, memo=None):
+            if memo is None and self.memos is not None and isinstance(x, ir.Block):
+                memo = self.memos.setdefault(id(x.scope), {})
+            return copy.deepcopy(x, memo)
+
+    shim = _SharedMemoCopy()
+    inline_ir = worker.inline_ir
+
+    def inline_ir_shared(self, *args, **kwargs):
+        outer, shim.memos = shim.memos, {}
+        try:
+            return inline_ir(self, *args, **kwargs)
+        finally:
+            shim.memos = outer
+
+    icc.copy = shim
+    worker.inline_ir = inline_ir_shared
+    worker._trackbench_shared = True
+
+
+_copy_inlined_ir_once()
