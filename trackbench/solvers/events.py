@@ -180,19 +180,25 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
                 if valid and level >= 0.0 and (g0 > level) != (g1 > level):
                     best = min(best, _bisect(kind, i, b, g0, level, step, nq, m, n_links))
                 if soil and kind == K_PIN_GROUND and valid and (g0 > 0.0 or g1 > 0.0):
-                    best = min(best, _soil_switch(i, b, (g0, g1), step, nq, m, ev))
+                    best = _soil_switch(i, b, (g0, g1), best, step, nq, m, ev)
     return best
 
 
 @njit(**BORROW)
-def _soil_switch(i, b, sinkage, step, nq, m, ev):
-    """Smallest t at which pin i on soft soil (on segment b) crosses a kink of the soil's
-    pressure law (soil_force.soil_kink), 2.0 if none. A pin left on its loading curve by the
-    last step (z = z_m) counts as above z_m: the kink is where it comes back below."""
-    best = 2.0
+def _soil_switch(i, b, sinkage, best, step, nq, m, ev):
+    """min(best, the smallest t at which pin i on soft soil (on segment b) crosses a kink of
+    the soil's pressure law, soil_force.soil_kink). A pin left on its loading curve by the
+    last step (z = z_m) counts as above z_m: the kink is where it comes back below. Only a
+    crossing before best is bisected (most steps hold several: one look at best first)."""
+    n_links = ev.pins0.shape[0] - 1
     for kink in range(N_KINKS):
         f0 = soil_kink(ev.pins0[i, 0], sinkage[0], kink, m.par, m.rut)
         f1 = soil_kink(ev.pins1[i, 0], sinkage[1], kink, m.par, m.rut)
-        if (f0 > -KINK_TOL) != (f1 > -KINK_TOL):
-            best = min(best, _bisect(K_PIN_GROUND, i, b, f0, -KINK_TOL, step, nq, m, ev.pins0.shape[0] - 1, kink))
+        if (f0 > -KINK_TOL) == (f1 > -KINK_TOL):
+            continue
+        if best < 1.0:
+            _, f_best = _gap_at(K_PIN_GROUND, i, b, best, step, nq, m, n_links, kink)
+            if (f_best > -KINK_TOL) == (f0 > -KINK_TOL):
+                continue
+        best = min(best, _bisect(K_PIN_GROUND, i, b, f0, -KINK_TOL, step, nq, m, n_links, kink))
     return best
