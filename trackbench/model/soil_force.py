@@ -4,9 +4,12 @@ Bekker's pressure-sinkage law p = (k_c / b + k_phi) z^n while the soil is loaded
 deepest sinkage z_m it has seen at that place; below z_m it unloads and reloads elastically,
 p = p(z_m) - K_e (z_m - z) (not above the first-loading curve), down to zero at the plastic
 sinkage z_m - p(z_m) / K_e (the rut).
-z_m is the soil's memory, one value per cell along x (ModelArrays.rut): raised only after an
-accepted step (remember_sinkage), so a rejected step leaves no trace, and the pressure is
-continuous where it is raised (at z = z_m both branches agree).
+z_m is the soil's memory along x: one node per cell centre (ModelArrays.rut), smoothly
+interpolated between the two nodes around x (rut_nodes), so that a pin sliding along the
+ground meets a memory with no jumps and no kinks (a jump in z_m is a jump in the elastic
+branch's pressure, which every step across a cell boundary met and was rejected at). It is
+raised only after an accepted step (remember_sinkage), so a rejected step leaves no trace,
+and the pressure is continuous where it is raised (at z = z_m both branches agree).
 
 Shear by Janosi-Hanamoto, tau = (c + p tan phi)(1 - exp(-j / K)), on the pin's area A: the
 shear displacement j is the pin's displacement along the surface since it touched the soil
@@ -48,18 +51,68 @@ def soil_pressure(z, z_max, n, k, ke):
 
 
 @njit(**INLINE)
-def rut_cell(x, par, rut):
-    """The memory cell under x, or -1 beyond the cells."""
-    c = int(math.floor((x - par[P_RUT_X0]) / par[P_RUT_DX]))
-    return c if 0 <= c < rut.shape[0] else -1
+def rut_nodes(x, par, rut):
+    """(c, w): the memory's node left of x (at a cell centre) and the weight of the node right
+    of it, w = 10 u^3 - 15 u^4 + 6 u^5 at the fraction u of the way: the memory is then
+    continuous with its slope and curvature along x (both zero at the nodes), so a pin sliding
+    at speed v meets no jump in the rate of its pressure (K_e z_m'' v^2 would be one). c = -1 beyond the nodes (fresh soil)."""
+    u = (x - par[P_RUT_X0]) / par[P_RUT_DX] - 0.5
+    c = int(math.floor(u))
+    if c < 0 or c + 1 >= rut.shape[0]:
+        return -1, 0.0
+    u -= c
+    return c, u * u * u * (10.0 + u * (6.0 * u - 15.0))
+
+
+@njit(**INLINE)
+def deepest_sinkage(x, par, rut):
+    """z_m at x: the nodes around it, weighted (0 on fresh soil)."""
+    c, wr = rut_nodes(x, par, rut)
+    if c < 0:
+        return 0.0
+    return (1.0 - wr) * rut[c] + wr * rut[c + 1]
 
 
 @njit(**INLINE)
 def pin_on_soil(x, z, par, rut):
     """Pressure under a pin at x sunk by z into the soil."""
-    c = rut_cell(x, par, rut)
-    z_max = rut[c] if c >= 0 else 0.0
-    return soil_pressure(z, z_max, par[P_SOIL_N], par[P_SOIL_K], par[P_SOIL_KE])
+    return soil_pressure(z, deepest_sinkage(x, par, rut), par[P_SOIL_N], par[P_SOIL_K], par[P_SOIL_KE])
+
+
+KINK_MEMORY = 0       # soil_kink: at the deepest sinkage z_m, loading meets the elastic line
+KINK_PLASTIC = 1      # at the plastic sinkage, the elastic line reaches zero pressure
+N_KINKS = 2
+KINK_TOL = 1e-12      # m: a pin within this of a kink is on it (z_m is raised to the sinkage
+                      # reached after an accepted step, up to rounding)
+
+
+@njit(**INLINE)
+def soil_kink(x, z, kink, par, rut):
+    """z minus the depth of a kink of the pressure law at x, for the event location: the
+    law's slope jumps there (from Bekker's to K_e, from K_e to none) and a step across it
+    is rejected unless it ends there."""
+    zm = deepest_sinkage(x, par, rut)
+    if kink == KINK_PLASTIC:
+        zm -= first_loading(zm, par[P_SOIL_N], par[P_SOIL_K]) / par[P_SOIL_KE]
+    return z - zm
+
+
+@njit(**INLINE)
+def _raise_memory(x, z, par, rut):
+    """Raise the nodes around x, never lowering one, so that z_m at x becomes z (when z is
+    deeper): both to z if z is deeper than both, else only the shallower one, just enough.
+    No node ends deeper than the deeper of its old value and z: a sliding pin leaves the
+    sinkage it reached, not more."""
+    c, wr = rut_nodes(x, par, rut)
+    if c < 0 or z <= (1.0 - wr) * rut[c] + wr * rut[c + 1]:
+        return
+    lo, hi = (c, c + 1) if rut[c] <= rut[c + 1] else (c + 1, c)
+    if z >= rut[hi]:
+        rut[c] = z
+        rut[c + 1] = z
+        return
+    w_lo = 1.0 - wr if lo == c else wr      # > 0 here: with w_lo = 0, z_m at x = rut[hi] > z
+    rut[lo] = min(max((z - (1.0 - w_lo) * rut[hi]) / w_lo, rut[lo]), rut[hi])
 
 
 @njit(**INLINE)
@@ -76,16 +129,14 @@ def soil_shear(x, y, x0, y0, t, normal, par):
 
 @njit(**BORROW)
 def remember_sinkage(m, w):
-    """After an accepted step (the last evaluation was at its end): each cell keeps the
-    deepest sinkage a pin reached in it; a pin that touched the soil in the step keeps
-    where, one that left it forgets."""
+    """After an accepted step (the last evaluation was at its end): the memory keeps the
+    deepest sinkage a pin reached (_raise_memory); a pin that touched the soil in the step
+    keeps where, one that left it forgets."""
     if m.par[P_SOIL] == 0.0:
         return
     for b in range(w.sink.shape[0]):
         if w.sink[b] > 0.0:
-            c = rut_cell(w.apos[b, 0], m.par, m.rut)
-            if c >= 0 and w.sink[b] > m.rut[c]:
-                m.rut[c] = w.sink[b]
+            _raise_memory(w.apos[b, 0], w.sink[b], m.par, m.rut)
             if m.touchdown[b, 0] != m.touchdown[b, 0]:
                 m.touchdown[b, 0] = w.apos[b, 0]
                 m.touchdown[b, 1] = w.apos[b, 1]

@@ -21,10 +21,11 @@ from ..model.gaps import (ground_distance, link_frame, pin_cap_weight, pin_groun
                           segment_coords)
 from ..model.contact_laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ..model.jit import BORROW, INLINE, KERNEL
+from ..model.soil_force import KINK_TOL, N_KINKS, soil_kink
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.index import nq_of, q_pin
 from ..model.layout import (
-    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_EVENT_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
+    K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, N_EVENT_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_SOIL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
 )
 from .hermite import coordinate, quintic_basis
 
@@ -91,13 +92,17 @@ def _pin_ground(px, py, sj, m, row):
 
 
 @njit(**BORROW)   # called, not inlined: each inlined copy cost ~25 s of compile time
-def _gap_at(kind, i, b, t, step, nq, m, n_links):
+def _gap_at(kind, i, b, t, step, nq, m, n_links, kink):
     """(valid, gap) of one candidate pair at fraction t of the step: kind K_*, i the wheel
-    or corner (the pin for K_PIN_GROUND), b the link or pin (the segment for K_PIN_GROUND)."""
+    or corner (the pin for K_PIN_GROUND), b the link or pin (the segment for K_PIN_GROUND).
+    kink >= 0 (soft soil, K_PIN_GROUND): the pin's sinkage minus that kink's depth instead."""
     w = quintic_basis(t)
     if kind == K_PIN_GROUND:
         px, py = _pin_at(i, w, step, nq, m, n_links)
-        return _pin_ground(px, py, b, m, m.nbr_rows[K_PIN_GROUND] + i)
+        valid, g = _pin_ground(px, py, b, m, m.nbr_rows[K_PIN_GROUND] + i)
+        if kink >= 0:
+            g = soil_kink(px, g, kink, m.par, m.rut)
+        return valid, g
     if kind == K_WHEEL_LINK or kind == K_WHEEL_PIN:
         p = _wheel_at(i, w, step, nq, m)
     else:
@@ -125,13 +130,14 @@ def _gap_end(kind, i, b, pins, wheels, m):
 
 
 @njit(**BORROW)
-def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
-    """Upper end of the bracket where the gap crosses level (just after the kink)."""
+def _bisect(kind, i, b, g0, level, step, nq, m, n_links, kink=-1):
+    """Upper end of the bracket where the gap (or the soil's kink function) crosses level
+    (just after the kink)."""
     lo = 0.0
     hi = 1.0
     for _ in range(BISECTIONS):
         mid = 0.5 * (lo + hi)
-        _, gm = _gap_at(kind, i, b, mid, step, nq, m, n_links)
+        _, gm = _gap_at(kind, i, b, mid, step, nq, m, n_links, kink)
         if (gm > level) == (g0 > level):
             lo = mid
         else:
@@ -143,7 +149,8 @@ def _bisect(kind, i, b, g0, level, step, nq, m, n_links):
 def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     """Smallest t in (0, 1] at which some candidate contact starts or ends along the
     step's interpolant - or, with the viscous law, reaches the end of its dashpot's ramp,
-    a kink of the same kind; 2.0 if none. Pairs whose validity (foot on link, wedge,
+    a kink of the same kind, or on soft soil a pin crosses a kink of the soil's pressure
+    law (_soil_switch); 2.0 if none. Pairs whose validity (foot on link, wedge,
     acting segment) changes are left alone. ev: EventWork scratch."""
     nq = nq_of(y0.shape[0])
     n_links = ev.pins0.shape[0] - 1
@@ -151,6 +158,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     place(y1[:nq], m.par, m.arms, m.ends, ev.pins1, ev.wheels1, ev.arm)
     step = (y0, f0, y1, f1, h)
     ramp = m.par[P_DAMPING_RAMP] if m.par[P_CONTACT_DAMPING] == DAMPING_VISCOUS else -1.0
+    soil = m.par[P_SOIL] != 0.0
     best = 2.0
     for kind in range(N_EVENT_KINDS):
         for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
@@ -171,4 +179,26 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
                 level = 0.0 if (g0 > 0.0) != (g1 > 0.0) else ramp
                 if valid and level >= 0.0 and (g0 > level) != (g1 > level):
                     best = min(best, _bisect(kind, i, b, g0, level, step, nq, m, n_links))
+                if soil and kind == K_PIN_GROUND and valid and (g0 > 0.0 or g1 > 0.0):
+                    best = _soil_switch(i, b, (g0, g1), best, step, nq, m, ev)
+    return best
+
+
+@njit(**BORROW)
+def _soil_switch(i, b, sinkage, best, step, nq, m, ev):
+    """min(best, the smallest t at which pin i on soft soil (on segment b) crosses a kink of
+    the soil's pressure law, soil_force.soil_kink). A pin left on its loading curve by the
+    last step (z = z_m) counts as above z_m: the kink is where it comes back below. Only a
+    crossing before best is bisected (most steps hold several: one look at best first)."""
+    n_links = ev.pins0.shape[0] - 1
+    for kink in range(N_KINKS):
+        f0 = soil_kink(ev.pins0[i, 0], sinkage[0], kink, m.par, m.rut)
+        f1 = soil_kink(ev.pins1[i, 0], sinkage[1], kink, m.par, m.rut)
+        if (f0 > -KINK_TOL) == (f1 > -KINK_TOL):
+            continue
+        if best < 1.0:
+            _, f_best = _gap_at(K_PIN_GROUND, i, b, best, step, nq, m, n_links, kink)
+            if (f_best > -KINK_TOL) == (f0 > -KINK_TOL):
+                continue
+        best = min(best, _bisect(K_PIN_GROUND, i, b, f0, -KINK_TOL, step, nq, m, n_links, kink))
     return best
