@@ -406,25 +406,43 @@ def test_soil_recording_logs_the_deformed_surface(soil_run, soil_recording):
     np.testing.assert_allclose(strips[-1, [0, -1]] * [1, -1], ground[[0, -1]], atol=1e-5)
 
 
+def _raise_nodes(rut, x, z, x0, dx):
+    """The soil memory's rule written out again: nodes at cell centres, quintic weights,
+    the shallower node raised just enough (both when z is deeper than both)."""
+    u = (x - x0) / dx - 0.5
+    c = int(np.floor(u))
+    if c < 0 or c + 1 >= rut.size:
+        return
+    u -= c
+    w = u * u * u * (10.0 + u * (6.0 * u - 15.0))
+    if z <= (1 - w) * rut[c] + w * rut[c + 1]:
+        return
+    if z >= max(rut[c], rut[c + 1]):
+        rut[c] = rut[c + 1] = z
+        return
+    lo, hi = (c, c + 1) if rut[c] <= rut[c + 1] else (c + 1, c)
+    w_lo = 1 - w if lo == c else w
+    rut[lo] = min(max((z - (1 - w_lo) * rut[hi]) / w_lo, rut[lo]), rut[hi])
+
+
 def test_soil_dent_matches_an_independent_rebuild(soil_run):
-    """The dent: the running maximum of the pins' sinkage binned into the rut cells, scaled per
-    cell to end at rut_depth; without the scaling it ends within the sampling's reach of
-    rut_max_sinkage."""
+    """The dent: the soil's memory replayed on the output samples, scaled per cell to end at
+    rut_depth; without the scaling it ends within the sampling's reach of rut_max_sinkage."""
     ds = soil_run
     rx, depth = ds["rut_x"].values, ds["rut_depth"].values
     dx = rx[1] - rx[0]
     n = ds.sizes["time"]
-    hist, last = G.running_sinkage(ds, np.arange(n), np.append(rx - dx / 2, rx[-1] + dx / 2))
-    cells = np.floor((ds["pin_x"].values - (rx[0] - dx / 2)) / dx).astype(int)
+    edges = np.append(rx - dx / 2, rx[-1] + dx / 2)
+    hist, last = G.running_sinkage(ds, np.arange(n), edges)
     want = np.zeros((n, rx.size))
+    rut = np.zeros(rx.size)
     for i in range(n):
-        for c, s in zip(cells[i], ds["sinkage"].values[i]):
-            if 0 <= c < rx.size and s > 0:
-                want[i, c] = max(want[i, c], s, want[i - 1, c] if i else 0.0)
-        if i:
-            want[i] = np.maximum(want[i], want[i - 1])
-    np.testing.assert_allclose(hist, want, atol=1e-12)
-    np.testing.assert_allclose(last, want[-1])
+        for x, s in zip(ds["pin_x"].values[i], ds["sinkage"].values[i]):
+            if s > 0:
+                _raise_nodes(rut, x, s, edges[0], edges[1] - edges[0])
+        want[i] = rut
+    np.testing.assert_array_equal(hist, want)
+    np.testing.assert_array_equal(last, want[-1])
     assert np.abs(last - ds["rut_max_sinkage"].values).max() < 0.01
     base, drop = G.soil_surface(ds, [0, n - 1])
     at = np.searchsorted(base[:, 0], rx[depth > 0] - 1e-9)

@@ -18,9 +18,10 @@ leaves), so a pin that slips by j shears the soil by j; it replaces Coulomb fric
 
 import math
 
+import numpy as np
 from numba import njit
 
-from .jit import BORROW, INLINE, SCALAR
+from .jit import BORROW, INLINE, KERNEL, SCALAR
 from .layout import (P_RUT_DX, P_RUT_X0, P_SOIL, P_SOIL_COHESION, P_SOIL_K, P_SOIL_KE, P_SOIL_N, P_SOIL_SHEAR_K,
                      P_SOIL_TAN_PHI)
 
@@ -51,14 +52,15 @@ def soil_pressure(z, z_max, n, k, ke):
 
 
 @njit(**INLINE)
-def rut_nodes(x, par, rut):
-    """(c, w): the memory's node left of x (at a cell centre) and the weight of the node right
-    of it, w = 10 u^3 - 15 u^4 + 6 u^5 at the fraction u of the way: the memory is then
-    continuous with its slope and curvature along x (both zero at the nodes), so a pin sliding
-    at speed v meets no jump in the rate of its pressure (K_e z_m'' v^2 would be one). c = -1 beyond the nodes (fresh soil)."""
-    u = (x - par[P_RUT_X0]) / par[P_RUT_DX] - 0.5
+def rut_nodes(x, x0, dx, n):
+    """(c, w): the memory's node left of x (nodes at the centres of the cells of width dx from
+    x0, n of them) and the weight of the node right of it, w = 10 u^3 - 15 u^4 + 6 u^5 at the
+    fraction u of the way: the memory is then continuous with its slope and curvature along x
+    (both zero at the nodes), so a pin sliding at speed v meets no jump in the rate of its
+    pressure (K_e z_m'' v^2 would be one). c = -1 beyond the nodes (fresh soil)."""
+    u = (x - x0) / dx - 0.5
     c = int(math.floor(u))
-    if c < 0 or c + 1 >= rut.shape[0]:
+    if c < 0 or c + 1 >= n:
         return -1, 0.0
     u -= c
     return c, u * u * u * (10.0 + u * (6.0 * u - 15.0))
@@ -67,7 +69,7 @@ def rut_nodes(x, par, rut):
 @njit(**INLINE)
 def deepest_sinkage(x, par, rut):
     """z_m at x: the nodes around it, weighted (0 on fresh soil)."""
-    c, wr = rut_nodes(x, par, rut)
+    c, wr = rut_nodes(x, par[P_RUT_X0], par[P_RUT_DX], rut.shape[0])
     if c < 0:
         return 0.0
     return (1.0 - wr) * rut[c] + wr * rut[c + 1]
@@ -98,12 +100,12 @@ def soil_kink(x, z, kink, par, rut):
 
 
 @njit(**INLINE)
-def _raise_memory(x, z, par, rut):
+def raise_memory(x, z, x0, dx, rut):
     """Raise the nodes around x, never lowering one, so that z_m at x becomes z (when z is
     deeper): both to z if z is deeper than both, else only the shallower one, just enough.
     No node ends deeper than the deeper of its old value and z: a sliding pin leaves the
     sinkage it reached, not more."""
-    c, wr = rut_nodes(x, par, rut)
+    c, wr = rut_nodes(x, x0, dx, rut.shape[0])
     if c < 0 or z <= (1.0 - wr) * rut[c] + wr * rut[c + 1]:
         return
     lo, hi = (c, c + 1) if rut[c] <= rut[c + 1] else (c + 1, c)
@@ -113,6 +115,23 @@ def _raise_memory(x, z, par, rut):
         return
     w_lo = 1.0 - wr if lo == c else wr      # > 0 here: with w_lo = 0, z_m at x = rut[hi] > z
     rut[lo] = min(max((z - (1.0 - w_lo) * rut[hi]) / w_lo, rut[lo]), rut[hi])
+
+
+@njit(**KERNEL)
+def replay_memory(px, sink, x0, dx, idx, out):
+    """The memory rebuilt from output samples (pin x and sinkage per sample), raised by the
+    rule above at each sample instead of after each step: out[j] = the nodes after sample
+    idx[j] (idx sorted). Returns the nodes after the last sample."""
+    rut = np.zeros(out.shape[1])
+    j = 0
+    for i in range(px.shape[0]):
+        for b in range(px.shape[1]):
+            if sink[i, b] > 0.0:
+                raise_memory(px[i, b], sink[i, b], x0, dx, rut)
+        while j < idx.shape[0] and idx[j] == i:
+            out[j, :] = rut
+            j += 1
+    return rut
 
 
 @njit(**INLINE)
@@ -130,13 +149,13 @@ def soil_shear(x, y, x0, y0, t, normal, par):
 @njit(**BORROW)
 def remember_sinkage(m, w):
     """After an accepted step (the last evaluation was at its end): the memory keeps the
-    deepest sinkage a pin reached (_raise_memory); a pin that touched the soil in the step
+    deepest sinkage a pin reached (raise_memory); a pin that touched the soil in the step
     keeps where, one that left it forgets."""
     if m.par[P_SOIL] == 0.0:
         return
     for b in range(w.sink.shape[0]):
         if w.sink[b] > 0.0:
-            _raise_memory(w.apos[b, 0], w.sink[b], m.par, m.rut)
+            raise_memory(w.apos[b, 0], w.sink[b], m.par[P_RUT_X0], m.par[P_RUT_DX], m.rut)
             if m.touchdown[b, 0] != m.touchdown[b, 0]:
                 m.touchdown[b, 0] = w.apos[b, 0]
                 m.touchdown[b, 1] = w.apos[b, 1]

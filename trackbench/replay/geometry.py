@@ -359,36 +359,22 @@ def _rut_cells(ds):
 
 
 def running_sinkage(ds, idx, edges):
-    """Deepest pin sinkage so far in each rut cell: (len(idx), k) at the frames idx (sorted),
-    and (k,) at the last sample of the run. The soil's memory is raised where the pins sink
-    (model.soil_force: a cell per pin, by its x; the links between pins leave no mark), so
-    the pins' sinkage is binned into the cells by their x (np.digitize), the maximum taken
-    per frame and cell, then the running maximum over time (np.maximum.accumulate), in
-    blocks of frames carrying the maximum."""
+    """Deepest sinkage so far along the rut: (len(idx), k) at the frames idx (sorted), and
+    (k,) after the last sample of the run, at the centres of the cells between edges. The
+    soil's own rule raises its memory (model.soil_force.raise_memory: nodes at the cell
+    centres, raised just enough under each sunk pin); here it is replayed on the pins'
+    output samples instead of after every step."""
+    from ..model.soil_force import replay_memory
     k = len(edges) - 1
     idx = np.asarray(idx, dtype=np.intp)
-    out = np.zeros((len(idx), k))
-    carry = np.zeros(k)
+    out = np.zeros((len(idx), max(k, 0)))
     if k <= 0:
-        return out, carry
-    px = ds.variables["pin_x"].values
-    sink = ds.variables["sinkage"].values
-    nt = px.shape[0]
-    step = max(1, min(1024, nt))
-    for lo in range(0, nt, step):
-        hi = min(nt, lo + step)
-        cell = np.digitize(px[lo:hi], edges) - 1                  # (nb, np)
-        s = sink[lo:hi]
-        ok = (cell >= 0) & (cell < k) & (s > 0.0)
-        rows = np.broadcast_to(np.arange(hi - lo)[:, None], cell.shape)[ok]
-        m = np.zeros((hi - lo, k))
-        np.maximum.at(m, (rows, cell[ok]), s[ok])
-        m[0] = np.maximum(m[0], carry)
-        np.maximum.accumulate(m, axis=0, out=m)
-        carry = m[-1].copy()
-        sel = (idx >= lo) & (idx < hi)
-        out[sel] = m[idx[sel] - lo]
-    return out, carry
+        return out, np.zeros(0)
+    px = np.ascontiguousarray(ds.variables["pin_x"].values, dtype=float)
+    sink = np.ascontiguousarray(ds.variables["sinkage"].values, dtype=float)
+    dx = float(edges[1] - edges[0])
+    last = replay_memory(px, sink, float(edges[0]), dx, idx, out)
+    return out, last
 
 
 def soil_surface(ds, idx, x_range=None):
@@ -400,15 +386,15 @@ def soil_surface(ds, idx, x_range=None):
     border one (the rut is drawn from cell centre to cell centre; it tapers to nothing over
     the half-cell beyond its first and last cells).
 
-    The rut up to time t in a cell is rebuilt from the outputs: the deepest sinkage of any
-    pin binned into the cell at a sample <= t (running_sinkage), scaled per cell by
-    rut_depth / (that maximum at the run's last sample). Chosen over the bare "deepest
+    The rut up to time t at a cell centre is rebuilt from the outputs: the soil's memory
+    replayed on the pin samples <= t (running_sinkage), scaled per cell by
+    rut_depth / (that memory after the run's last sample). Chosen over the bare "deepest
     sinkage so far" so that the last frame draws exactly the Dataset's rut_depth: the soil
     keeps only the plastic part (it springs back by the elastic part, a few per cent), and
-    the pins are sampled at output times only, so the bare maximum can miss or overshoot
-    the cell's true maximum by a bin width's worth. Cells no pin was seen in (a pin passed
-    over one between two output samples) take the history of the nearest cell that
-    was seen, scaled to their own rut_depth. The drop is vertical, by depth / cos(slope) of
+    the pins are sampled at output times only, so the replayed memory can miss or overshoot
+    the true one by a sample's travel. Cells the replay never reached (a pin passed over
+    one between two output samples) take the history of the nearest cell it reached,
+    scaled to their own rut_depth. The drop is vertical, by depth / cos(slope) of
     the ground segment under the point: the soil's sinkage is along the segment's normal."""
     ground = ground_polyline(ds, x_range)
     idx = np.asarray(idx, dtype=np.intp)
