@@ -101,3 +101,35 @@ def test_thrust_against_slip_matches_wong_within_5_percent(slip):
     assert fig["slip"] == pytest.approx(slip, abs=0.02)
     assert fig["drawbar_load"] == pytest.approx(fig["thrust"], rel=0.03)
     assert fig["thrust"] == pytest.approx(f_wong, rel=0.05)
+
+
+def _fake_soil_run(path, slip, pull):
+    """A timeseries.nc with what the drawbar-pull plot reads: a closed run on LETE sand."""
+    import json
+
+    import xarray as xr
+    t = np.linspace(0.0, 1.0, 11)
+    sink = np.zeros((t.size, 4))
+    sink[:, :3] = 0.01
+    sc = {"terrain": {"kind": "flat", "soil": "lete_sand"}, "track": {"link_length": 0.19, "width": 0.5}}
+    ds = xr.Dataset({"slip": ("time", np.full(t.size, slip)), "drawbar_pull": ("time", np.full(t.size, pull)),
+                     "drawbar_load": ("time", np.full(t.size, pull)), "sprocket_torque": ("time", np.full(t.size, 1e4)),
+                     "ground_force_y": ("time", np.full(t.size, 2e5)), "sinkage": (("time", "pin"), sink),
+                     "pin_x": (("time", "pin"), np.tile([0.4, 0.2, 0.0, -0.2], (t.size, 1)))},
+                    coords={"time": t}, attrs={"scenario": json.dumps(sc), "closed_layout": json.dumps({"pitch_radius": 0.3})})
+    path.parent.mkdir(parents=True)
+    ds.to_netcdf(path)
+
+
+def test_study_plot_draws_drawbar_pull_against_slip(tmp_path):
+    pytest.importorskip("matplotlib")
+    import pandas as pd
+    from trackbench.replay.plots import plot_study
+    rows = []
+    for k, (slip, pull) in enumerate(((0.1, 1.2e5), (0.3, 1.3e5))):
+        _fake_soil_run(tmp_path / "runs" / f"r{k}" / "timeseries.nc", slip, pull)
+        rows.append({"run_id": f"r{k}", "status": "completed", "drawbar.slip": slip, "peak_wheel1_force_y": 1e5})
+    pd.DataFrame(rows).to_csv(tmp_path / "summary.csv", index=False)
+    paths = plot_study(tmp_path, tmp_path / "plots")
+    assert tmp_path / "plots" / "study_drawbar_pull.png" in paths
+    assert (tmp_path / "plots" / "study_drawbar_pull.png").stat().st_size > 10_000

@@ -44,7 +44,7 @@ def steady(ds, since):
     return {
         "slip": float(np.nanmean(ds.slip.values[late])),
         "thrust": float(ds.drawbar_pull.values[late].mean()),
-        "drawbar_load": float(ds.drawbar_load.values[late].mean()),
+        "drawbar_load": float(ds.drawbar_load.values[late].mean()) if "drawbar_load" in ds else float("nan"),
         "sprocket_pull": float(ds.sprocket_torque.values[late].mean()) / pitch_radius,
         "weight": float(ds.ground_force_y.values[late].mean()),
         "pins": n,

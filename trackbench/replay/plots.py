@@ -381,21 +381,22 @@ def plot_study(study_dir, out_dir):
 
 
 def _steady_point(ds):
-    """(soil name, slip, drawbar pull N): means over the second half of a closed run on soft
-    soil, else None."""
+    """(soil name, slip, drawbar pull N, Wong's thrust N): means over the second half of a
+    closed run on soft soil (trackbench/traction.py), else None."""
     import json
-    from ..traction import has_traction
+    from ..traction import has_traction, run_soil, steady, wong
     if not has_traction(ds):
         return None
     soil = json.loads(ds.attrs["scenario"])["terrain"].get("soil")
-    late = ds.time.values >= 0.5 * float(ds.time.values[-1])
-    return (soil if isinstance(soil, str) else "soil table", float(np.nanmean(ds.slip.values[late])),
-            float(ds.drawbar_pull.values[late].mean()))
+    fig = steady(ds, 0.5 * float(ds.time.values[-1]))
+    return (soil if isinstance(soil, str) else "soil table", fig["slip"], fig["thrust"], wong(fig, run_soil(ds))[0])
 
 
 def _plot_drawbar_pull(src, ok, out):
     """Drawbar pull against slip, one curve per soil, when the study's completed runs drive
-    the closed track on soft soil (study_drawbar_pull.png); None otherwise."""
+    the closed track on soft soil (study_drawbar_pull.png), and Wong's thrust of a uniformly
+    loaded track of each run's contact and weight (dashed; on flat soil the drawbar pull is
+    the thrust: trackbench/traction.py); None otherwise."""
     import xarray as xr
     points = []
     for rid in ok.get("run_id", []):
@@ -410,8 +411,10 @@ def _plot_drawbar_pull(src, ok, out):
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k, soil in enumerate(sorted({p[0] for p in points})):
-        xy = np.array(sorted((p[1], p[2]) for p in points if p[0] == soil))
+        xy = np.array(sorted(p[1:] for p in points if p[0] == soil))
         ax.plot(100 * xy[:, 0], xy[:, 1] / 1e3, "o-", color=f"C{k}", ms=4, label=soil.replace("_", " "))
+        ax.plot(100 * xy[:, 0], xy[:, 2] / 1e3, "--", color=f"C{k}", lw=1,
+                label=f"{soil.replace('_', ' ')}: Wong's thrust, uniform pressure")
     ax.set_xlabel("slip (%)")
     ax.set_ylabel("drawbar pull (kN)")
     ax.grid(True, alpha=0.3)
