@@ -387,16 +387,22 @@ def _steady_point(ds):
     from ..traction import has_traction, run_soil, steady, wong
     if not has_traction(ds):
         return None
-    soil = json.loads(ds.attrs["scenario"])["terrain"].get("soil")
+    sc = json.loads(ds.attrs["scenario"])
+    soil = sc["terrain"].get("soil")
     fig = steady(ds, 0.5 * float(ds.time.values[-1]))
-    return (soil if isinstance(soil, str) else "soil table", fig["slip"], fig["thrust"], wong(fig, run_soil(ds))[0])
+    # Wong's steady thrust only where a drawbar holds the vehicle at it: a free vehicle's few
+    # kN of pull at a few % slip is not on his curve
+    bar = sc.get("drawbar", {})
+    held = bar.get("load", 0.0) != 0.0 or bar.get("slip", 0.0) > 0.0
+    return (soil if isinstance(soil, str) else "soil table", fig["slip"], fig["thrust"],
+            wong(fig, run_soil(ds))[0] if held else np.nan)
 
 
 def _plot_drawbar_pull(src, ok, out):
     """Drawbar pull against slip, one curve per soil, when the study's completed runs drive
-    the closed track on soft soil (study_drawbar_pull.png), and Wong's thrust of a uniformly
-    loaded track of each run's contact and weight (dashed; on flat soil the drawbar pull is
-    the thrust: trackbench/traction.py); None otherwise."""
+    the closed track on soft soil (study_drawbar_pull.png), and, for runs held by a drawbar,
+    Wong's thrust of a uniformly loaded track of each run's contact and weight (dashed; on flat
+    soil the drawbar pull is the thrust: trackbench/traction.py); None otherwise."""
     import xarray as xr
     points = []
     for rid in ok.get("run_id", []):
@@ -413,12 +419,13 @@ def _plot_drawbar_pull(src, ok, out):
     for k, soil in enumerate(sorted({p[0] for p in points})):
         xy = np.array(sorted(p[1:] for p in points if p[0] == soil))
         ax.plot(100 * xy[:, 0], xy[:, 1] / 1e3, "o-", color=f"C{k}", ms=4, label=soil.replace("_", " "))
-        ax.plot(100 * xy[:, 0], xy[:, 2] / 1e3, "--", color=f"C{k}", lw=1,
-                label=f"{soil.replace('_', ' ')}: Wong's thrust, uniform pressure")
+        if np.isfinite(xy[:, 2]).any():
+            ax.plot(100 * xy[:, 0], xy[:, 2] / 1e3, "--", color=f"C{k}", lw=1,
+                    label=f"{soil.replace('_', ' ')}: Wong's thrust, uniform pressure")
     ax.set_xlabel("slip (%)")
     ax.set_ylabel("drawbar pull (kN)")
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="best")
     ax.set_title(f"study {src.parent.name}: drawbar pull against slip (means over each run's second half)",
                  fontsize=10)
     fig.tight_layout()
