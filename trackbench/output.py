@@ -175,6 +175,8 @@ def _closed_layout(model, result, scenario, placed):
         "idler_x": _var(T, guides[:, 0, 0], "m", "idler centre x"),
         "idler_y": _var(T, guides[:, 0, 1], "m", "idler centre y"),
         "drive_work": _var(T, y[:, 2 * nq + L.Y_DRIVE_WORK], "J", "work done by the drive on the sprocket since t = 0"),
+        "drawbar_load": _var(T, d[:, L.D_DRAWBAR], "N", "force of the drawbar (constant load and towing rig) on the "
+                             "chassis, rearward positive"),
         "upper_span_tension": _var(T, spans[:, 0], "N", "tension of the upper span where it leaves the sprocket "
                                    "(the second link from the last pin on the teeth)"),
         "lower_span_tension": _var(T, spans[:, 1], "N", "tension of the lower span where it leaves the sprocket"),

@@ -134,6 +134,10 @@ RULES = {
     "drive.gain_p": _NONNEG,
     "drive.gain_i": _NONNEG,
     "drive.torque_limit": _POS,
+    "drawbar.load": (float, -1e7, 1e7, "a number in [-1e7, 1e7] N (rearward positive; 0: none)"),
+    "drawbar.hitch": (list, None, None, "a pair [x, y] of finite numbers (m, body point)"),
+    "drawbar.slip": (float, 0.0, 0.95, "a number in [0, 0.95] (0: no towing rig)"),
+    "drawbar.rig_damping": (float, 0.0, math.inf, "a number > 0 (N s/m)"),
     "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
     "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
     "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
@@ -142,7 +146,7 @@ RULES = {
     "record.enabled": (bool, None, None, "true or false"),
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }
-_OPEN_LOW = {"duration", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent", "track.width",
+_OPEN_LOW = {"duration", "drawbar.rig_damping", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent", "track.width",
              "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed",
              "contact.friction_velocity"} | {
     k for k, r in RULES.items() if r is _POS}
@@ -373,7 +377,7 @@ def _check_geometry(v, tr):
                             f"(n_links * link_length = {free:.4g} m, path {path:.4g} m); allowed: at most 10 %")
 
 
-_CLOSED_GROUPS = ("sprocket", "idler", "rollers", "drive")
+_CLOSED_GROUPS = ("sprocket", "idler", "rollers", "drive", "drawbar")
 
 
 def _pairs(name, value, increasing=False, limit=None):
@@ -385,6 +389,18 @@ def _pairs(name, value, increasing=False, limit=None):
     if limit is not None and len(arr) > limit:
         raise ScenarioError(f"{name} has {len(arr)} pairs; allowed: at most {limit}")
     return arr.tolist()
+
+
+def _check_drawbar(out):
+    hitch = out["drawbar"]["hitch"]
+    if len(hitch) != 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                                  for x in hitch):
+        raise ScenarioError(f"drawbar.hitch = {hitch!r} is not allowed: expected a pair [x, y] of finite numbers "
+                            "(m, body point)")
+    out["drawbar"]["hitch"] = [float(x) for x in hitch]
+    if out["drawbar"]["slip"] > 0.0 and out["drive"]["kind"] != "speed":
+        raise ScenarioError(f"drawbar.slip = {out['drawbar']['slip']} needs drive.kind = 'speed' (the drive holds "
+                            f"the sprocket at the rig's slip), not '{out['drive']['kind']}'")
 
 
 def _check_closed(out, explicit):
@@ -411,6 +427,7 @@ def _check_closed(out, explicit):
     out["drive"]["curve"] = _pairs("drive.curve", out["drive"]["curve"], True, LP_CURVE_POINTS)
     if out["drive"]["kind"] == "torque" and "drive.torque" not in explicit and not out["drive"]["curve"]:
         raise ScenarioError("drive.kind = 'torque' needs drive.torque (N m) or drive.curve")
+    _check_drawbar(out)
     try:
         g = closed_geometry(out["vehicle"], out["track"], out["sprocket"], out["idler"], out["rollers"],
                             frozenset(explicit))

@@ -31,18 +31,18 @@ def _closed(scenario):
 
 def _closed_key(scenario):
     return json.dumps([scenario[k] for k in ("vehicle", "track", "gravity", "contact", "sprocket", "idler",
-                                             "rollers", "drive")], sort_keys=True)
+                                             "rollers", "drive", "drawbar")], sort_keys=True)
 
 
 @functools.lru_cache(maxsize=32)
 def _closed_parts_cached(key):
     from .model.closed import closed_geometry, guide_table, loop_vector
-    vehicle, track, gravity, contact, spr, idl, rol, drive = json.loads(key)
+    vehicle, track, gravity, contact, spr, idl, rol, drive, drawbar = json.loads(key)
     g = closed_geometry(vehicle, track, spr, idl, rol, frozenset({"track.n_links"}))
     c = 0.0
     if contact["damping"] == "viscous":   # the contacts' rule: c = 2 zeta sqrt(k m_pin)
         c = 2.0 * contact["damping_ratio"] * np.sqrt(spr["stiffness"] * track["pin_mass"])
-    return g, loop_vector(g, spr, idl, drive, c), guide_table(g, track, idl, rol)
+    return g, loop_vector(g, spr, idl, drive, c, drawbar), guide_table(g, track, idl, rol)
 
 
 def closed_parts(scenario: Scenario):
@@ -52,10 +52,11 @@ def closed_parts(scenario: Scenario):
 
 @functools.lru_cache(maxsize=32)
 def _loop_equilibrium_cached(key, soil):
+    from .model.closed import without_drawbar
     from .model.equilibrium import solve_loop_equilibrium
     vehicle, track, gravity, contact, *_ = json.loads(key)
     g, lp, guides = _closed_parts_cached(key)
-    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, lp, guides,
+    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, without_drawbar(lp), guides,
                                   {int(k): v for k, v in json.loads(soil).items()})
 
 

@@ -215,9 +215,9 @@ def _check_rollers(tr, rol, circles):
                                     f"(within track.link_length = {tr['link_length']} m)")
 
 
-def loop_vector(g, spr, idl, drive, contact_c):
+def loop_vector(g, spr, idl, drive, contact_c, drawbar=None):
     """The LP_* vector of the kernels. contact_c: the viscous coefficient of pin-tooth
-    contacts (N s/m; 0 = none)."""
+    contacts (N s/m; 0 = none); drawbar: the drawbar group (None: no drawbar)."""
     lp = np.zeros(L.N_LOOP)
     lp[L.LP_SPROCKET_X], lp[L.LP_SPROCKET_Y] = g.sprocket
     lp[L.LP_SPROCKET_INERTIA] = spr["inertia"]
@@ -244,7 +244,20 @@ def loop_vector(g, spr, idl, drive, contact_c):
     curve = np.asarray(drive["curve"], float).reshape(-1, 2)
     lp[L.LP_CURVE] = len(curve)
     lp[L.LP_CURVE + 1:L.LP_CURVE + 1 + curve.size] = curve.ravel()
+    if drawbar:
+        lp[L.LP_DRAWBAR_LOAD] = drawbar["load"]
+        lp[L.LP_HITCH_X], lp[L.LP_HITCH_Y] = drawbar["hitch"]
+        lp[L.LP_RIG_SLIP] = drawbar["slip"]
+        lp[L.LP_RIG_DAMPING] = drawbar["rig_damping"]
     return lp
+
+
+def without_drawbar(lp):
+    """A copy of the LP_* vector with no drawbar: the vehicle at rest, before anything pulls."""
+    out = lp.copy()
+    out[L.LP_DRAWBAR_LOAD] = 0.0
+    out[L.LP_RIG_SLIP] = 0.0
+    return out
 
 
 def guide_table(g, tr, idl, rol):

@@ -199,7 +199,13 @@ LP_TRAVEL = 22           # the idler's slide stays within +-travel (m)
 LP_FLANK_ANGLE = 23      # flare of the teeth's flanks, the pressure angle (rad)
 LP_CURVE = 24            # torque-speed curve: LP_CURVE_POINTS pairs (sprocket speed rad/s, torque N m) after it
 LP_CURVE_POINTS = 16
-N_LOOP = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # [LP_CURVE] holds the number of points used
+# the drawbar on the chassis (model/drive.py): a constant load and the towing rig
+LP_DRAWBAR_LOAD = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # rearward horizontal force at the hitch (N)
+LP_HITCH_X = LP_DRAWBAR_LOAD + 1   # body point of the hitch (m)
+LP_HITCH_Y = LP_DRAWBAR_LOAD + 2
+LP_RIG_SLIP = LP_DRAWBAR_LOAD + 3  # slip the towing rig sets (0: no rig)
+LP_RIG_DAMPING = LP_DRAWBAR_LOAD + 4   # dashpot of the rig's carriage on the hitch (N s/m)
+N_LOOP = LP_RIG_DAMPING + 1
 
 # drive.kind codes (model/drive.py)
 DRIVE_NONE, DRIVE_TORQUE, DRIVE_SPEED = 0, 1, 2
@@ -299,7 +305,8 @@ D_DISSIPATION = 16       # dD/dt: power dissipated by all dampers (W)
 D_DRIVE_TORQUE = 17      # torque of the drive on the sprocket, forward positive (N m; closed layout)
 D_IDLER_FORCE = 18       # tensioner force along the guide, outward positive (N)
 D_TEETH_TORQUE = 19      # torque of the pins on the sprocket, forward positive (N m)
-D_WHEEL = 20             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
+D_DRAWBAR = 20           # force of the drawbar on the chassis, rearward positive (N; closed layout)
+D_WHEEL = 21             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
 def diag_tension(n_wheels):

@@ -24,13 +24,13 @@ from ..status import IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET, WHEEL_THROUGH_TRACK
 from .bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COLS, ARM_D, ARM_Q, LOOP_IDLER, LOOP_SPROCKET
 from .contact_force import normal_force
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
-from .drive import drive_torque
+from .drive import drawbar_on_chassis, drive_torque, has_drawbar, held_speed
 from .index import diag_tension, nq_of, q_idler, q_pin, q_sprocket
 from .jit import BORROW, INLINE, KERNEL
 from .kernels import _probe_on_track, contact_law, ground_contacts, link_tensions, refresh_neighbours, wheel_contacts
 from .kinematics import body_offset, place_wheels, wheel_velocities
 from .layout import (
-    C_EVALUATIONS, D_DISSIPATION, D_DRIVE_TORQUE,
+    C_EVALUATIONS, D_DISSIPATION, D_DRAWBAR, D_DRIVE_TORQUE,
     D_E_PAD_WHEEL, D_IDLER_FORCE, D_POWER, D_STATUS, D_TEETH_TORQUE, G_BX, G_BY, G_REACH,
     K_GUIDE_LINK, K_GUIDE_PIN, LP_TRAVEL, P_C_WHEEL, P_CONTACT_GEOMETRY, LP_GUIDE_X, LP_GUIDE_Y, LP_IDLER_MASS, LP_PRELOAD, LP_SPROCKET_INERTIA,
     LP_SPROCKET_X, LP_SPROCKET_Y, LP_TENSIONER_DAMPING, LP_TENSIONER_STIFFNESS, LP_TOOTH_DAMPING,
@@ -268,13 +268,18 @@ def loop_rhs(y, m, w, ydot, diag):
     loop_loads(w, m, diag)
     # the drive (forward = clockwise, psi counter-clockwise) and the tensioner
     omega = -qd[i_spr]
-    tau, d_integral = drive_torque(lp, qd[Q_X], omega, y[2 * nq + Y_DRIVE_INTEGRAL])
+    tau, d_integral = drive_torque(lp, held_speed(lp, qd[Q_X], omega), omega, y[2 * nq + Y_DRIVE_INTEGRAL])
     sd = qd[i_idl]
     tension_force = lp[LP_PRELOAD] - lp[LP_TENSIONER_STIFFNESS] * q[i_idl] - lp[LP_TENSIONER_DAMPING] * sd
     if abs(q[i_idl]) > lp[LP_TRAVEL]:
         diag[D_STATUS] = IDLER_OFF_GUIDE
-    a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, w.fwheel, w.wv, w.wc, w.arm, c, s,
-                                                _chassis_own(q, m, w))
+    own = _chassis_own(q, m, w)
+    drawbar = drawbar_power = 0.0
+    if has_drawbar(lp):
+        fx, torque, drawbar_power = drawbar_on_chassis(lp, qd[Q_X], qd[Q_PITCH], c, s)
+        own = (own[0] + fx, own[1], own[2] + torque)
+        drawbar = -fx
+    a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, w.fwheel, w.wv, w.wc, w.arm, c, s, own)
     ke, e_tors, e_grav = e
     inertia = lp[LP_SPROCKET_INERTIA]
     _row(w.extra, LOOP_SPROCKET, 0.0, 0.0, inertia, inertia, w.spr[SP_TORQUE] - tau)
@@ -299,13 +304,14 @@ def loop_rhs(y, m, w, ydot, diag):
     drive_power = tau * omega
     tensioner_damping = lp[LP_TENSIONER_DAMPING] * sd * sd
     diag[D_DISSIPATION] += arm_dissipation + tensioner_damping
-    ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation + drive_power + tension_force * sd
+    ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation + drive_power + tension_force * sd + drawbar_power
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
     ydot[2 * nq + Y_DRIVE_WORK] = drive_power
     ydot[2 * nq + Y_DRIVE_INTEGRAL] = d_integral
     store_state_energies(diag, (ke, e_tors, e_grav), acc3[0], acc3[1])
     diag[D_DRIVE_TORQUE] = tau
     diag[D_IDLER_FORCE] = tension_force
+    diag[D_DRAWBAR] = drawbar
     diag[D_TEETH_TORQUE] = -w.spr[SP_TORQUE]
 
 

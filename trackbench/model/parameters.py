@@ -89,6 +89,12 @@ def closed_defaults():
             "gain_i": 3.0e4,
             "torque_limit": 3.0e4,        # speed drive: |torque| at most (N m)
         },
+        "drawbar": {
+            "load": 0.0,                  # constant rearward horizontal force at the hitch (N); 0: none
+            "hitch": [0.0, 0.0],          # body point where the drawbar pulls (m); the mass centre: no pitching moment
+            "slip": 0.0,                  # towing rig: the slip it sets (0: no rig; needs drive.kind = "speed")
+            "rig_damping": 2.0e6,         # towing rig: dashpot from its carriage at drive.target to the hitch (N s/m)
+        },
     }
 
 

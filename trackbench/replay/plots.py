@@ -1,7 +1,8 @@
 """The paper's result figures (Figs. 8-18 of Lee, 2000) as PNG files, and study plots.
 
     plot_run(ds_or_path, out_dir, times=(0.1, 0.35, 0.45)) -> [PNG paths]
-    plot_study(study_dir, out_dir) -> [PNG paths]      # one figure per grid axis
+    plot_study(study_dir, out_dir) -> [PNG paths]      # one figure per grid axis (+ drawbar pull
+                                                       #   against slip for soil runs)
 
 matplotlib is an optional dependency (extra "plot"); it is imported here only.
 """
@@ -375,7 +376,63 @@ def plot_study(study_dir, out_dir):
         fig.savefig(path, dpi=DPI)
         plt.close(fig)
         paths.append(path)
-    return paths
+    drawbar = _plot_drawbar_pull(src, ok, out)
+    return paths + ([drawbar] if drawbar else [])
+
+
+def _steady_point(ds):
+    """(soil name, slip, drawbar pull N, Wong's thrust N): means over the second half of a
+    closed run on soft soil (trackbench/traction.py), else None."""
+    import json
+    from ..traction import has_traction, run_soil, steady, wong
+    if not has_traction(ds):
+        return None
+    sc = json.loads(ds.attrs["scenario"])
+    soil = sc["terrain"].get("soil")
+    fig = steady(ds, 0.5 * float(ds.time.values[-1]))
+    # Wong's steady thrust only where a drawbar holds the vehicle at it: a free vehicle's few
+    # kN of pull at a few % slip is not on his curve
+    bar = sc.get("drawbar", {})
+    held = bar.get("load", 0.0) != 0.0 or bar.get("slip", 0.0) > 0.0
+    return (soil if isinstance(soil, str) else "soil table", fig["slip"], fig["thrust"],
+            wong(fig, run_soil(ds))[0] if held else np.nan)
+
+
+def _plot_drawbar_pull(src, ok, out):
+    """Drawbar pull against slip, one curve per soil, when the study's completed runs drive
+    the closed track on soft soil (study_drawbar_pull.png), and, for runs held by a drawbar,
+    Wong's thrust of a uniformly loaded track of each run's contact and weight (dashed; on flat
+    soil the drawbar pull is the thrust: trackbench/traction.py); None otherwise."""
+    import xarray as xr
+    points = []
+    for rid in ok.get("run_id", []):
+        path = src.parent / "runs" / str(rid) / "timeseries.nc"
+        if path.exists():
+            with xr.open_dataset(path) as ds:
+                p = _steady_point(ds)
+            if p is not None:
+                points.append(p)
+    if not points:
+        return None
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for k, soil in enumerate(sorted({p[0] for p in points})):
+        xy = np.array(sorted(p[1:] for p in points if p[0] == soil))
+        ax.plot(100 * xy[:, 0], xy[:, 1] / 1e3, "o-", color=f"C{k}", ms=4, label=soil.replace("_", " "))
+        if np.isfinite(xy[:, 2]).any():
+            ax.plot(100 * xy[:, 0], xy[:, 2] / 1e3, "--", color=f"C{k}", lw=1,
+                    label=f"{soil.replace('_', ' ')}: Wong's thrust, uniform pressure")
+    ax.set_xlabel("slip (%)")
+    ax.set_ylabel("drawbar pull (kN)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    ax.set_title(f"study {src.parent.name}: drawbar pull against slip (means over each run's second half)",
+                 fontsize=10)
+    fig.tight_layout()
+    path = out / "study_drawbar_pull.png"
+    fig.savefig(path, dpi=DPI)
+    plt.close(fig)
+    return path
 
 
 _UNITS = {"speed": "m/s", "duration": "s", "gravity": "m/s^2", "tolerance": "", "output_interval": "s",

@@ -1,0 +1,136 @@
+"""The drawbar on the closed track's chassis (model/drive.py): its input, its force and work,
+and the drawbar test on LETE sand against Wong's closed form (trackbench/traction.py)."""
+
+import math
+
+import numpy as np
+import pytest
+
+import trackbench as tb
+from trackbench.model import layout as L
+from trackbench.model.drive import drawbar_on_chassis, held_speed
+from trackbench.scenario import ScenarioError
+from trackbench.traction import run_soil, steady, wong
+
+CLOSED = {"track.layout": "closed"}
+
+
+@pytest.mark.parametrize("over, words", [
+    ({"drawbar.load": 1e3, "track.layout": "paper"}, "closed track only"),
+    ({**CLOSED, "drawbar.slip": 0.2}, "needs drive.kind = 'speed'"),
+    ({**CLOSED, "drive.kind": "speed", "drawbar.slip": 0.99}, "[0, 0.95]"),
+    ({**CLOSED, "drawbar.hitch": [1.0]}, "pair [x, y]"),
+    ({**CLOSED, "drawbar.hitch": [1.0, math.inf]}, "pair [x, y]"),
+    ({**CLOSED, "drawbar.rig_damping": 0.0}, "> 0"),
+    ({**CLOSED, "drawbar.lod": 1.0}, "did you mean drawbar.load"),
+])
+def test_bad_drawbar(over, words):
+    with pytest.raises(ScenarioError) as e:
+        tb.Scenario.from_dict(over)
+    assert words in str(e.value) and "\n" not in str(e.value)
+
+
+def test_drawbar_force_torque_and_power():
+    """The load and the rig's dashpot at a hitch below the mass centre: force, its moment
+    about the mass centre and its power at the hitch's speed."""
+    lp = np.zeros(L.N_LOOP)
+    lp[L.LP_DRAWBAR_LOAD] = 1e4
+    lp[L.LP_HITCH_X], lp[L.LP_HITCH_Y] = -2.0, -0.5
+    lp[L.LP_RIG_SLIP], lp[L.LP_RIG_DAMPING], lp[L.LP_TARGET], lp[L.LP_PITCH_RADIUS] = 0.2, 1e6, 4.0, 0.3
+    vx, om = 4.01, 0.1          # level chassis: the hitch moves at vx - om * (-0.5)
+    f, torque, power = drawbar_on_chassis(lp, vx, om, 1.0, 0.0)
+    v_hitch = vx + 0.5 * om
+    assert f == pytest.approx(-1e4 - 1e6 * (v_hitch - 4.0))
+    assert torque == pytest.approx(0.5 * f)          # a rearward pull below the centre pitches the nose up
+    assert power == pytest.approx(f * v_hitch)
+    assert held_speed(lp, vx, 20.0) == pytest.approx(20.0 * 0.3 * 0.8)   # the rig: the sprocket's speed
+    lp[L.LP_RIG_SLIP] = 0.0
+    assert held_speed(lp, vx, 20.0) == vx
+
+
+def test_constant_load_is_taken_by_the_drive_and_its_work_is_booked():
+    """A constant 20 kN drawbar at a low rear hitch on the speed-driven closed track on LETE
+    sand: the chassis' momentum balance (ground's horizontal force - load = mass x
+    acceleration, on average), and the work-based energy residual stays below 1e-6 of E0
+    with the drawbar's work in it."""
+    sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat", "soil": "lete_sand"}, "preset": "damped",
+                                "drive.kind": "speed", "speed": 4.0, "drawbar.load": 2e4,
+                                "drawbar.hitch": [-3.0, -0.4], "duration": 0.3, "output_interval": 1e-3})
+    ds = tb.simulate(sc)
+    assert ds.attrs["status"] == "completed"
+    assert np.allclose(ds.drawbar_load.values, 2e4)
+    mass = float(ds.attrs["weight"]) / sc["gravity"]
+    dv = ds.chassis_vx.values[-1] - ds.chassis_vx.values[0]
+    impulse = np.trapezoid(ds.drawbar_pull.values - ds.drawbar_load.values, ds.time.values)
+    assert dv == pytest.approx(impulse / mass, abs=0.02)    # the track's own momentum swings a little
+    assert float(abs(ds.energy_residual).max()) < 1e-6
+
+
+SETTLE = 0.6        # s: the rig's slip is reached in ~0.2 s, the thrust after the track ran one contact length
+
+
+def _drawbar_run(slip):
+    """benchmarks/bench_soil.py's drawbar test, shortened to 1.2 s."""
+    sc = tb.Scenario.from_dict({
+        "terrain": {"kind": "flat", "soil": "lete_sand"}, **CLOSED, "preset": "damped", "drive.kind": "speed",
+        "speed": 4.0, "drive.gain_p": 2e5, "drive.gain_i": 2e6, "drive.torque_limit": 1e5, "drawbar.slip": slip,
+        "duration": 1.2, "output_interval": 2e-3})
+    ds = tb.simulate(sc)
+    assert ds.attrs["status"] == "completed"
+    assert float(abs(ds.energy_residual).max()) < 1e-6
+    fig = steady(ds, SETTLE)
+    return fig, wong(fig, run_soil(ds))[0]
+
+
+LOW_SLIP = pytest.param(0.05, marks=pytest.mark.xfail(strict=True, reason=(
+    "at 5 % slip (4.3 % measured) the thrust is 65 % below Wong's here (45 vs 128 kN over 0.6-1.2 s; 54 % over "
+    "0.6-2 s in bench_soil.py, still rising; -5.0 % at 10 %): "
+    "the paper's soft links (k 8e6 N/m) stretch ~5 % more at the rear of the contact than at the front, so "
+    "the pins creep behind the sprocket's speed and the soil sees less slip than the sprocket's; the steady "
+    "state also takes seconds to come"
+)))
+
+
+@pytest.mark.parametrize("slip", [LOW_SLIP, 0.3])
+def test_thrust_against_slip_matches_wong_within_5_percent(slip):
+    """Gross thrust (the soil shear's x, = drawbar_pull on flat soil) of the vehicle held at a
+    slip by the towing rig, against Wong's closed form for a uniformly loaded track of the
+    same contact length, area and weight at the measured slip: within 5 %. The rig holds the
+    set slip to 0.02, and the drawbar takes the thrust (steady: the mean horizontal
+    momentum does not change)."""
+    fig, f_wong = _drawbar_run(slip)
+    assert fig["slip"] == pytest.approx(slip, abs=0.02)
+    assert fig["drawbar_load"] == pytest.approx(fig["thrust"], rel=0.03)
+    assert fig["thrust"] == pytest.approx(f_wong, rel=0.05)
+
+
+def _fake_soil_run(path, slip, pull):
+    """A timeseries.nc with what the drawbar-pull plot reads: a closed run on LETE sand."""
+    import json
+
+    import xarray as xr
+    t = np.linspace(0.0, 1.0, 11)
+    sink = np.zeros((t.size, 4))
+    sink[:, :3] = 0.01
+    sc = {"terrain": {"kind": "flat", "soil": "lete_sand"}, "track": {"link_length": 0.19, "width": 0.5}}
+    ds = xr.Dataset({"slip": ("time", np.full(t.size, slip)), "drawbar_pull": ("time", np.full(t.size, pull)),
+                     "drawbar_load": ("time", np.full(t.size, pull)), "sprocket_torque": ("time", np.full(t.size, 1e4)),
+                     "ground_force_y": ("time", np.full(t.size, 2e5)), "sinkage": (("time", "pin"), sink),
+                     "pin_x": (("time", "pin"), np.tile([0.4, 0.2, 0.0, -0.2], (t.size, 1)))},
+                    coords={"time": t}, attrs={"scenario": json.dumps(sc), "closed_layout": json.dumps({"pitch_radius": 0.3})})
+    path.parent.mkdir(parents=True)
+    ds.to_netcdf(path)
+
+
+def test_study_plot_draws_drawbar_pull_against_slip(tmp_path):
+    pytest.importorskip("matplotlib")
+    import pandas as pd
+    from trackbench.replay.plots import plot_study
+    rows = []
+    for k, (slip, pull) in enumerate(((0.1, 1.2e5), (0.3, 1.3e5))):
+        _fake_soil_run(tmp_path / "runs" / f"r{k}" / "timeseries.nc", slip, pull)
+        rows.append({"run_id": f"r{k}", "status": "completed", "drawbar.slip": slip, "peak_wheel1_force_y": 1e5})
+    pd.DataFrame(rows).to_csv(tmp_path / "summary.csv", index=False)
+    paths = plot_study(tmp_path, tmp_path / "plots")
+    assert tmp_path / "plots" / "study_drawbar_pull.png" in paths
+    assert (tmp_path / "plots" / "study_drawbar_pull.png").stat().st_size > 10_000
