@@ -14,6 +14,7 @@ from trackbench.model.reduced import reduced_rhs
 from trackbench.simulate import Model, build_ground, equilibrium
 from trackbench.model.contact_laws import GEOMETRY_CONTINUOUS
 from trackbench.model.gaps import pin_cap_weight
+from trackbench.model.bundles import EventWork
 from trackbench.solvers.events import _gap_end
 
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
@@ -37,6 +38,7 @@ def _event_energy(m, w, par):
     """Pad energies (wheel side, ground side) over the pairs the event location calls
     active, each as often as it counts (_weight)."""
     place_pins, place_wheels = w.apos.copy(), w.wc.copy()
+    ev = EventWork(place_pins, place_pins, place_wheels, place_wheels, w.arm.copy())
     continuous = par[L.P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     energy = {"wheel": 0.0, "ground": 0.0}
     for kind in range(L.N_KINDS):
@@ -45,7 +47,7 @@ def _event_energy(m, w, par):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, L.NB_COUNT]):
                 b = m.nbr[row, 1 + j]
-                valid, gap = _gap_end(kind, i, b, place_pins, place_wheels, m)
+                valid, gap = _gap_end(kind, i, b, 0, m, ev)
                 if valid and gap > 0.0:
                     weight = _weight(kind, i, b, m, place_pins, place_wheels, continuous)
                     energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
