@@ -41,7 +41,7 @@ from .layout import (
 )
 from .reduced import (chassis_acceleration, chassis_and_arms, pin_accelerations, row_acceleration, start_rates,
                       store_state_energies, take_out_rows)
-from .sprocket import pin_on_sprocket
+from .sprocket import pin_on_teeth, tooth_shape
 
 @njit(**INLINE)
 def _loop_pins(coords, nw, out):
@@ -149,11 +149,12 @@ def _teeth(w, m, diag):
     law = (int(par[P_CONTACT_LAW]), DAMPING_VISCOUS if c > 0.0 else DAMPING_NONE, lp[LP_TOOTH_STIFFNESS],
            par[P_CONTACT_EXPONENT], c, 0.0, par[P_DAMPING_RAMP])
     om = spr[SP_RATE]
+    shape = tooth_shape(lp)
     fx = fy = torque = energy = power = dissipation = 0.0
     for b in range(1, apos.shape[0]):
         dx = apos[b, 0] - spr[SP_X]
         dy = apos[b, 1] - spr[SP_Y]
-        pen, nx, ny, inside = pin_on_sprocket(dx, dy, spr[SP_ANGLE], lp)
+        pen, nx, ny, inside = pin_on_teeth(dx, dy, spr[SP_ANGLE], shape)
         if inside:
             diag[D_STATUS] = PIN_THROUGH_SPROCKET
             continue

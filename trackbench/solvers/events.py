@@ -25,7 +25,7 @@ from ..model.contact_laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.loop import guide_offset, place_loop
-from ..model.sprocket import pin_on_sprocket
+from ..model.sprocket import pin_on_teeth, tooth_shape
 from ..model.index import nq_of, q_idler, q_pin, q_sprocket
 from ..model.layout import (
     G_REACH, K_CORNER_LINK, K_CORNER_PIN, K_GUIDE_LINK, K_GUIDE_PIN, K_PIN_GROUND, K_TEETH, K_WHEEL_LINK, K_WHEEL_PIN,
@@ -129,13 +129,13 @@ def _guide_end_impl(j, e, ev):
 
 
 @njit(**INLINE)
-def _teeth_gap(px, py, q, lp):
+def _teeth_gap(px, py, q, lp, shape):
     """r_pin - distance of the pin at (px, py) to the tooth profile (in contact where > 0:
-    model/sprocket.py), q = (x, y, pitch, sprocket angle psi) of chassis and sprocket; the
-    axis placed as loop.py places it."""
+    model/sprocket.py; shape its tooth_shape), q = (x, y, pitch, sprocket angle psi) of
+    chassis and sprocket; the axis placed as loop.py places it."""
     x, y, th, psi = q
     ax, ay = body_offset(math.cos(th), math.sin(th), lp[LP_SPROCKET_X], lp[LP_SPROCKET_Y])
-    return pin_on_sprocket(px - (x + ax), py - (y + ay), th + psi, lp)[0]
+    return pin_on_teeth(px - (x + ax), py - (y + ay), th + psi, shape)[0]
 
 
 def _teeth_gap_at(b, t, step, nq, m, n_links, ev):
@@ -151,7 +151,7 @@ def _teeth_gap_at_impl(b, t, step, nq, m, n_links, ev):
             px, py = _loop_pin_at(b, w, step, nq, m, n_links)
             q = (coordinate(w, step, Q_X, nq), coordinate(w, step, Q_Y, nq), coordinate(w, step, Q_PITCH, nq),
                  coordinate(w, step, q_sprocket(m.arms.shape[0], n_links), nq))
-            return _teeth_gap(px, py, q, m.loop)
+            return _teeth_gap(px, py, q, m.loop, tooth_shape(m.loop))
         return closed
     return lambda b, t, step, nq, m, n_links, ev: -1.0
 
@@ -311,9 +311,12 @@ def _teeth_switch_impl(step, nq, m, ev, best):
             i_s = q_sprocket(m.arms.shape[0], ev.pins0.shape[0] - 1)
             # the teeth's own dashpot (loop.py _teeth), viscous where set
             ramp = m.par[P_DAMPING_RAMP] if m.loop[LP_TOOTH_DAMPING] > 0.0 else -1.0
+            shape = tooth_shape(m.loop)
             for b in range(1, ev.pins0.shape[0]):
-                g0 = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], (y0[Q_X], y0[Q_Y], y0[Q_PITCH], y0[i_s]), m.loop)
-                g1 = _teeth_gap(ev.pins1[b, 0], ev.pins1[b, 1], (y1[Q_X], y1[Q_Y], y1[Q_PITCH], y1[i_s]), m.loop)
+                q0 = (y0[Q_X], y0[Q_Y], y0[Q_PITCH], y0[i_s])
+                q1 = (y1[Q_X], y1[Q_Y], y1[Q_PITCH], y1[i_s])
+                g0 = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], q0, m.loop, shape)
+                g1 = _teeth_gap(ev.pins1[b, 0], ev.pins1[b, 1], q1, m.loop, shape)
                 best = _switch((K_TEETH, b, 0), g0, g1, True, ramp, step, nq, m, ev, best)
             return best
         return closed
