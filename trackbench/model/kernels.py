@@ -408,6 +408,8 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
         row = first + b
         if on_soil:
             sink[b] = 0.0
+        if nbr[row, NB_COUNT] == 0:    # no ground within reach (the closed track's top run): no call
+            continue
         if continuous:
             inside, n_below, best = False, 0, 0.0
         else:
