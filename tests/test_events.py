@@ -14,6 +14,7 @@ from trackbench.model.reduced import reduced_rhs
 from trackbench.simulate import Model, build_ground, equilibrium
 from trackbench.model.contact_laws import GEOMETRY_CONTINUOUS
 from trackbench.model.gaps import pin_cap_weight
+from trackbench.model.bundles import EventWork
 from trackbench.solvers.events import _gap_end
 
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
@@ -37,6 +38,7 @@ def _event_energy(m, w, par):
     """Pad energies (wheel side, ground side) over the pairs the event location calls
     active, each as often as it counts (_weight)."""
     place_pins, place_wheels = w.apos.copy(), w.wc.copy()
+    ev = EventWork(place_pins, place_pins, place_wheels, place_wheels, w.arm.copy())
     continuous = par[L.P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     energy = {"wheel": 0.0, "ground": 0.0}
     for kind in range(L.N_KINDS):
@@ -45,7 +47,7 @@ def _event_energy(m, w, par):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, L.NB_COUNT]):
                 b = m.nbr[row, 1 + j]
-                valid, gap = _gap_end(kind, i, b, place_pins, place_wheels, m)
+                valid, gap = _gap_end(kind, i, b, 0, m, ev)
                 if valid and gap > 0.0:
                     weight = _weight(kind, i, b, m, place_pins, place_wheels, continuous)
                     energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
@@ -85,3 +87,67 @@ def test_event_contact_decision_equals_the_kernels(geometry, request):
             checked["wheel"] += e["wheel"] > 0
             checked["ground"] += e["ground"] > 0
     assert checked["wheel"] > 100 and checked["ground"] > 100
+
+
+def test_closed_event_contact_decision_equals_the_kernels():
+    """The closed layout: road wheels, idler, ground and the sprocket's teeth as the event
+    location sees them (its scratch placed by loop.place_loop) carry the kernels' pad
+    energies, pins moved within a pad's depth of every threshold."""
+    from trackbench.model.bundles import event_arrays
+    from trackbench.model.loop import loop_rhs, place_loop
+    from trackbench.simulate import initial_state
+    from trackbench.model.sprocket import tooth_shape
+    from trackbench.solvers.events import _teeth_gap
+
+    sc = tb.Scenario.from_dict({"track.layout": "closed"})
+    eq = equilibrium(sc)
+    model = _model(sc)
+    m, w = model.arrays, model.work
+    y0 = initial_state(sc, eq)
+    nq, n = model.nq, model.n_links
+    off = L.pin_offset(model.nw)
+    i_s = L.q_sprocket(model.nw, n)
+    ev = event_arrays(model.nw, n, m.guides.shape[0])
+    rng = np.random.default_rng(3)
+    checked = {"wheel": 0, "ground": 0, "teeth": 0}
+    for _ in range(40):
+        y = y0.copy()
+        y[off:off + 2 * n] += rng.uniform(-0.01, 0.01, 2 * n)
+        y[i_s] += rng.uniform(-0.05, 0.05)
+        d = np.zeros(L.n_diag(model.nw, n))
+        loop_rhs(y, m, w, np.zeros_like(y), d)
+        if d[L.D_STATUS] != 0.0:
+            continue
+        place_loop(y[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
+        energy = {"wheel": 0.0, "ground": 0.0}
+        pins = np.vstack([ev.pins0, ev.pins0[1]])          # pin 1 after pin n_links
+        for kind in range(L.N_KINDS):
+            k = m.par[L.P_K_GROUND] if kind in GROUND_KINDS else m.par[L.P_K_WHEEL]
+            for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
+                i = row - m.nbr_rows[kind]
+                for j in range(m.nbr[row, L.NB_COUNT]):
+                    b = m.nbr[row, 1 + j]
+                    valid, gap = _gap_end(kind, i, b, 0, m, ev)
+                    if valid and gap > 0.0:
+                        weight = 1
+                        if kind == L.K_PIN_GROUND:       # continuous geometry: one contact per pin
+                            weight = int(b == m.nbr[row, 1])
+                        elif kind in (L.K_WHEEL_PIN, L.K_GUIDE_PIN, L.K_CORNER_PIN):
+                            probes = {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0, L.K_CORNER_PIN: m.corners}
+                            p = probes[kind][i]
+                            t0 = (pins[b] - pins[b - 1]) / np.linalg.norm(pins[b] - pins[b - 1])
+                            t1 = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
+                            weight = pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1],
+                                                    kind != L.K_CORNER_PIN, True)
+                        energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
+        teeth = 0.0
+        for b in range(1, n + 1):
+            g = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], (y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH], y[i_s]), m.loop,
+                           tooth_shape(m.loop))
+            teeth += 0.5 * m.loop[L.LP_TOOTH_STIFFNESS] * g * g if g > 0.0 else 0.0
+        assert energy["wheel"] + teeth == pytest.approx(d[L.D_E_PAD_WHEEL], rel=1e-9, abs=1e-9)
+        assert energy["ground"] == pytest.approx(d[L.D_E_PAD_GROUND], rel=1e-9, abs=1e-9)
+        checked["wheel"] += energy["wheel"] > 0
+        checked["ground"] += energy["ground"] > 0
+        checked["teeth"] += teeth > 0
+    assert min(checked.values()) > 20

@@ -121,17 +121,20 @@ def _span_links(on_teeth, mid_y):
     """Per sample, the links of the upper and the lower span one link away from the sprocket:
     the link after the one from the last pin that can touch the teeth (that one's pull still
     depends on where its pin sits on a flank). Pins in array order; link b joins pins[b - 1]
-    and pins[b] (link 0: the last pin and the first)."""
+    and pins[b] (link 0: the last pin and the first). -1 where the loop does not leave the
+    teeth at exactly two places. Whole arrays at once: a loop over 5001 samples took 0.3 s."""
     n = on_teeth.shape[1]
-    out = np.full((on_teeth.shape[0], 2), -1)
-    for k in range(on_teeth.shape[0]):
-        t = on_teeth[k]
-        ends = [b for b in range(n) if t[b - 1] != t[b]]
-        if len(ends) != 2:
-            continue
-        spans = [(b + 1) % n if t[b - 1] else (b - 1) % n for b in ends]   # one link further away
-        up = int(np.argmax([mid_y[k, b] for b in spans]))
-        out[k] = spans[up], spans[1 - up]
+    before = np.roll(on_teeth, 1, axis=1)                 # t[b - 1]
+    change = before != on_teeth
+    two = change.sum(axis=1) == 2
+    ends = np.argsort(~change, axis=1, kind="stable")[:, :2]   # the two changes, in pin order
+    rows = np.arange(on_teeth.shape[0])[:, None]
+    spans = np.where(before[rows, ends], (ends + 1) % n, (ends - 1) % n)   # one link further away
+    m = mid_y[rows, spans]
+    # the upper span first; argmax's choice on ties and NaN: the first unless only it is NaN
+    up = (m[:, 1] > m[:, 0]) | (np.isnan(m[:, 1]) & ~np.isnan(m[:, 0]))
+    out = np.where(up[:, None], spans[:, ::-1], spans)
+    out[~two] = -1
     return out
 
 

@@ -118,11 +118,17 @@ ARM_D = ARM_COLS                   # column of LoopWork.extra: the diagonal mass
 
 
 # Scratch of the event location (solvers/events.py): the configuration at both ends of
-# a rejected step.
+# a rejected step; the closed layout's adds its idler and rollers.
 EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "arm"])
+LoopEventWork = namedtuple("LoopEventWork", list(EventWork._fields) + ["guides0", "guides1"])
 
 
-def event_arrays(n_wheels, n_links):
+def event_arrays(n_wheels, n_links, n_guides=None):
+    """EventWork for the paper's layout, LoopEventWork (n_guides: idler and rollers) for
+    the closed one."""
     n_pins = n_links + 1
-    return EventWork(np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_wheels, 2)),
-                     np.zeros((n_wheels, 2)), np.zeros((n_wheels, ARM_COLS)))
+    base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
+            np.zeros((n_wheels, ARM_COLS)))
+    if n_guides is None:
+        return EventWork(*base)
+    return LoopEventWork(*base, np.zeros((n_guides, 2)), np.zeros((n_guides, 2)))

@@ -350,6 +350,17 @@ def _probe_on_track(probe, rule, rows, w, nbr, law, continuous, mem, diag, acc):
 
 
 @njit(**INLINE)
+def round_on_track(probe, reach, rows, w, m, law, continuous, mem, diag, acc):
+    """A round body (road wheel, idler, roller: centre and velocity in probe, wheel radius +
+    pad h_w in reach) pressing the track from inside, frictionless: _probe_on_track with
+    the body's own force (acc's first two) from 0 and the other sums carried on."""
+    rule = (1.0, reach, reach, WHEEL_THROUGH_TRACK, 0.0, 1.0)
+    _, _, normal, energy, power, obstacle, dissipation = acc
+    acc = (0.0, 0.0, normal, energy, power, obstacle, dissipation)
+    return _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag, acc)
+
+
+@njit(**INLINE)
 def wheel_contacts(w, m, diag, mem):
     """Every road wheel against the track: links (Fig. 3, Eq. 4), then pin caps (Fig. 4).
     mem: see law_force."""
@@ -357,14 +368,11 @@ def wheel_contacts(w, m, diag, mem):
     law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
-    rule = (1.0, rho, rho, WHEEL_THROUGH_TRACK, 0.0, 1.0)   # frictionless
     acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for i in range(w.fwheel.shape[0]):
         probe = (w.wc[i, 0], w.wc[i, 1], w.wv[i, 0], w.wv[i, 1])
-        _, _, normal, energy, power, obstacle, dissipation = acc
-        acc = (0.0, 0.0, normal, energy, power, obstacle, dissipation)   # this wheel's force from 0
         rows = (m.nbr_rows[K_WHEEL_LINK] + i, m.nbr_rows[K_WHEEL_PIN] + i)
-        acc = _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag, acc)
+        acc = round_on_track(probe, rho, rows, w, m, law, continuous, mem, diag, acc)
         fwx = 0.0 - acc[0]
         fwy = 0.0 - acc[1]
         w.fwheel[i, 0] = fwx
@@ -400,6 +408,8 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
         row = first + b
         if on_soil:
             sink[b] = 0.0
+        if nbr[row, NB_COUNT] == 0:    # no ground within reach (the closed track's top run): no call
+            continue
         if continuous:
             inside, n_below, best = False, 0, 0.0
         else:

@@ -143,7 +143,7 @@ K_PIN_GROUND = 4         # row: pin b (0..n_links); entries: segments j   (Fig. 
 K_GUIDE_LINK = 5         # row: idler or roller j; entries: links b (closed layout)
 K_GUIDE_PIN = 6          # row: idler or roller j; entries: free pins b
 N_KINDS = 7
-N_EVENT_KINDS = 5        # the kinds whose onsets the event location finds (the paper's)
+K_TEETH = N_KINDS        # no candidate list: a pin against the sprocket's teeth, for the event location
 
 
 def neighbour_rows(n_wheels, n_corners, n_links, n_guides=0):

@@ -20,14 +20,14 @@ work-based energy residual stays a check of the integration.
 import numpy as np
 from numba import njit
 
-from ..status import IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET, WHEEL_THROUGH_TRACK
+from ..status import IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET
 from .bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COLS, ARM_D, ARM_Q, LOOP_IDLER, LOOP_SPROCKET
 from .contact_force import normal_force
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from .drive import drawbar_on_chassis, drive_torque, has_drawbar, held_speed
 from .index import diag_tension, nq_of, q_idler, q_pin, q_sprocket
 from .jit import BORROW, INLINE, KERNEL
-from .kernels import _probe_on_track, contact_law, ground_contacts, link_tensions, refresh_neighbours, wheel_contacts
+from .kernels import contact_law, ground_contacts, link_tensions, refresh_neighbours, round_on_track, wheel_contacts
 from .kinematics import body_offset, place_wheels, wheel_velocities
 from .layout import (
     C_EVALUATIONS, D_DISSIPATION, D_DRAWBAR, D_DRIVE_TORQUE,
@@ -41,7 +41,7 @@ from .layout import (
 )
 from .reduced import (chassis_acceleration, chassis_and_arms, pin_accelerations, row_acceleration, start_rates,
                       store_state_energies, take_out_rows)
-from .sprocket import pin_on_sprocket
+from .sprocket import pin_on_teeth, tooth_shape
 
 @njit(**INLINE)
 def _loop_pins(coords, nw, out):
@@ -56,12 +56,22 @@ def _loop_pins(coords, nw, out):
 
 
 @njit(**INLINE)
-def idler_offset(q, lp, guides, n_links, nw, c, s):
-    """The idler centre relative to the chassis mass centre, and R u (the guide in the world)."""
-    sl = q[q_idler(nw, n_links)]
+def idler_offset(sl, lp, guides, c, s):
+    """The idler centre at slide sl relative to the chassis mass centre, and R u (the guide
+    in the world)."""
     ux, uy = body_offset(c, s, lp[LP_GUIDE_X], lp[LP_GUIDE_Y])
     rx, ry = body_offset(c, s, guides[0, G_BX], guides[0, G_BY])
     return rx + sl * ux, ry + sl * uy, ux, uy
+
+
+@njit(**INLINE)
+def guide_offset(j, sl, m, c, s):
+    """Centre of guide j (0 the idler at slide sl, then the rollers) relative to the chassis
+    mass centre, and the idler's guide direction in the world (0 for a roller)."""
+    if j == 0:
+        return idler_offset(sl, m.loop, m.guides, c, s)
+    rx, ry = body_offset(c, s, m.guides[j, G_BX], m.guides[j, G_BY])
+    return rx, ry, 0.0, 0.0
 
 
 @njit(**INLINE)
@@ -72,11 +82,9 @@ def place_loop(q, m, apos, wc, arm, gc):
     n = apos.shape[0] - 1
     c, s = place_wheels(q, m.par, m.arms, wc, arm)
     _loop_pins(q, nw, apos)
-    rx, ry, _, _ = idler_offset(q, m.loop, m.guides, n, nw, c, s)
-    gc[0, 0] = q[Q_X] + rx
-    gc[0, 1] = q[Q_Y] + ry
-    for j in range(1, gc.shape[0]):
-        rx, ry = body_offset(c, s, m.guides[j, G_BX], m.guides[j, G_BY])
+    sl = q[q_idler(nw, n)]
+    for j in range(gc.shape[0]):
+        rx, ry, _, _ = guide_offset(j, sl, m, c, s)
         gc[j, 0] = q[Q_X] + rx
         gc[j, 1] = q[Q_Y] + ry
     return c, s
@@ -84,21 +92,23 @@ def place_loop(q, m, apos, wc, arm, gc):
 
 @njit(**INLINE)
 def _loop_positions(q, qd, m, w):
-    """place_loop, the velocities, and the sprocket's axis and angle (w.spr)."""
+    """Pins, wheels, idler and rollers with their velocities (each guide placed once), and
+    the sprocket's axis and angle (w.spr)."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
-    c, s = place_loop(q, m, w.apos, w.wc, w.arm, w.gc)
+    c, s = place_wheels(q, m.par, m.arms, w.wc, w.arm)
+    _loop_pins(q, nw, w.apos)
     wheel_velocities(qd, m.par, m.arms, w.wv, w.arm, c, s)
     _loop_pins(qd, nw, w.avel)
     om = qd[Q_PITCH]
-    rx, ry, ux, uy = idler_offset(q, m.loop, m.guides, n, nw, c, s)
+    sl = q[q_idler(nw, n)]
     sd = qd[q_idler(nw, n)]
-    w.gv[0, 0] = qd[Q_X] - om * ry + sd * ux
-    w.gv[0, 1] = qd[Q_Y] + om * rx + sd * uy
-    for j in range(1, w.gc.shape[0]):
-        rx, ry = body_offset(c, s, m.guides[j, G_BX], m.guides[j, G_BY])
-        w.gv[j, 0] = qd[Q_X] - om * ry
-        w.gv[j, 1] = qd[Q_Y] + om * rx
+    for j in range(w.gc.shape[0]):
+        rx, ry, ux, uy = guide_offset(j, sl, m, c, s)    # (ux, uy) = 0 for a roller
+        w.gc[j, 0] = q[Q_X] + rx
+        w.gc[j, 1] = q[Q_Y] + ry
+        w.gv[j, 0] = qd[Q_X] - om * ry + sd * ux
+        w.gv[j, 1] = qd[Q_Y] + om * rx + sd * uy
     rx, ry = body_offset(c, s, m.loop[LP_SPROCKET_X], m.loop[LP_SPROCKET_Y])
     spr = w.spr
     spr[SP_X] = q[Q_X] + rx
@@ -113,24 +123,20 @@ def _loop_positions(q, qd, m, w):
 @njit(**INLINE)
 def _guide_contacts(w, m, diag, mem):
     """The idler and the rollers against the track from inside, frictionless, as the road
-    wheels (kernels.wheel_contacts, the same law); their forces into w.fguide."""
+    wheels (kernels.round_on_track, the same law); their forces into w.fguide."""
     par = m.par
     law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
-    energy = 0.0
+    acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for j in range(w.gc.shape[0]):
-        reach = m.guides[j, G_REACH]
-        rule = (1.0, reach, reach, WHEEL_THROUGH_TRACK, 0.0, 1.0)
         probe = (w.gc[j, 0], w.gc[j, 1], w.gv[j, 0], w.gv[j, 1])
         rows = (m.nbr_rows[K_GUIDE_LINK] + j, m.nbr_rows[K_GUIDE_PIN] + j)
-        acc = _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag,
-                              (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+        acc = round_on_track(probe, m.guides[j, G_REACH], rows, w, m, law, continuous, mem, diag, acc)
         w.fguide[j, 0] = -acc[0]
         w.fguide[j, 1] = -acc[1]
-        energy += acc[3]
-        diag[D_POWER] += acc[4]
-        diag[D_DISSIPATION] += acc[6]
-    diag[D_E_PAD_WHEEL] += energy
+    diag[D_E_PAD_WHEEL] += acc[3]
+    diag[D_POWER] += acc[4]
+    diag[D_DISSIPATION] += acc[6]
 
 
 @njit(**INLINE)
@@ -143,11 +149,12 @@ def _teeth(w, m, diag):
     law = (int(par[P_CONTACT_LAW]), DAMPING_VISCOUS if c > 0.0 else DAMPING_NONE, lp[LP_TOOTH_STIFFNESS],
            par[P_CONTACT_EXPONENT], c, 0.0, par[P_DAMPING_RAMP])
     om = spr[SP_RATE]
+    shape = tooth_shape(lp)
     fx = fy = torque = energy = power = dissipation = 0.0
     for b in range(1, apos.shape[0]):
         dx = apos[b, 0] - spr[SP_X]
         dy = apos[b, 1] - spr[SP_Y]
-        pen, nx, ny, inside = pin_on_sprocket(dx, dy, spr[SP_ANGLE], lp)
+        pen, nx, ny, inside = pin_on_teeth(dx, dy, spr[SP_ANGLE], shape)
         if inside:
             diag[D_STATUS] = PIN_THROUGH_SPROCKET
             continue
@@ -227,7 +234,9 @@ def _idler(q, qd, m, w, c, s, force):
     n = w.apos.shape[0] - 1
     mi = m.loop[LP_IDLER_MASS]
     g = m.par[P_GRAVITY]
-    rx, ry, ux, uy = idler_offset(q, m.loop, m.guides, n, nw, c, s)
+    rx = w.gc[0, 0] - q[Q_X]           # placed by _loop_positions
+    ry = w.gc[0, 1] - q[Q_Y]
+    ux, uy = body_offset(c, s, m.loop[LP_GUIDE_X], m.loop[LP_GUIDE_Y])
     om = qd[Q_PITCH]
     sd = qd[q_idler(nw, n)]
     # velocity-dependent acceleration of the idler centre: centripetal and Coriolis

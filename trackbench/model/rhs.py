@@ -25,22 +25,3 @@ def _rhs(y, m, w, ydot, diag):
     if _closed(w):
         return lambda y, m, w, ydot, diag: loop_rhs(y, m, w, ydot, diag)
     return lambda y, m, w, ydot, diag: reduced_rhs(y, m, w, ydot, diag)
-
-
-def contact_switch(y0, f0, y1, f1, h, m, w, ev):
-    """solvers/events.first_contact_switch for the paper's layout; the closed layout's
-    steps are not cut at contact switches (2.0: none located), the step-size control
-    alone takes them."""
-    from ..solvers.events import first_contact_switch
-    if isinstance(w, LoopWork):
-        return 2.0
-    return first_contact_switch(y0, f0, y1, f1, h, m, ev)
-
-
-@overload(contact_switch, jit_options={"cache": True})
-def _contact_switch(y0, f0, y1, f1, h, m, w, ev):
-    from ..solvers.events import first_contact_switch
-    if _closed(w):
-        return lambda y0, f0, y1, f1, h, m, w, ev: 2.0
-    return lambda y0, f0, y1, f1, h, m, w, ev: first_contact_switch(y0, f0, y1, f1, h, m, ev)
-

@@ -36,50 +36,75 @@ def _nearer(best, bx, by, px, py, qx, qy):
 
 
 @njit(**INLINE)
-def _gap_nearest(a, b, rs, rg, rt, alpha, pitch):
-    """Nearest point of the profile to the point (a, b) in the frame of the nearest gap (a
-    along the gap's centre line from its seat centre, b across it, b >= 0: by symmetry one
-    side), as (squared distance, a, b) of that point."""
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    best, na, nb = math.inf, 0.0, 0.0
-    r = math.sqrt(a * a + b * b)
-    if a <= 0.0 and r > 0.0:        # the seat's half circle
-        best, na, nb = _nearer(best, na, nb, a, b, rg * a / r, rg * b / r)
-    best, na, nb = _nearer(best, na, nb, a, b, 0.0, rg)
-    t_end = flank_length(rs, rg, rt, alpha)        # the flank from (0, rg) along (cos, sin) alpha
-    t = min(max(a * ca + (b - rg) * sa, 0.0), t_end)
-    best, na, nb = _nearer(best, na, nb, a, b, t * ca, rg + t * sa)
-    # the tooth top beyond the flank's corner, on the tip circle, up to the half pitch
-    ox, oy = rs + a, b                              # the point seen from the axis, gap along x
-    corner = math.atan2(rg + t_end * sa, rs + t_end * ca)
-    ang = min(max(math.atan2(oy, ox), corner), 0.5 * pitch)
-    best, na, nb = _nearer(best, na, nb, a, b, rt * math.cos(ang) - rs, rt * math.sin(ang))
-    return best, na, nb
-
-
-@njit(**INLINE)
-def _in_gap(a, b, rg, alpha):
-    """Is the point (a, b >= 0) inside the gap's seat or between its flanks?"""
-    if a <= 0.0:
-        return a * a + b * b < rg * rg
-    return b < rg + a * math.tan(alpha)
-
-
-@njit(**INLINE)
-def pin_on_sprocket(dx, dy, angle, lp):
-    """A pin at (dx, dy) from the sprocket axis, the sprocket turned by angle (CCW):
-    (penetration, nx, ny, inside). The penetration is r_pin minus the distance to the
-    profile (contact where > 0), (nx, ny) the unit direction that pushes the pin out of
-    it; inside is True where the pin's centre lies inside a tooth (it went through)."""
+def tooth_shape(lp):
+    """The profile's constants, once per evaluation rather than once per pin (they took
+    most of the teeth's time): (r_g, r_t, r_pin, r_s, pitch angle, the flank's direction cos
+    and sin alpha, tan alpha, the flank's length, then the tip arc's ends, the flank's
+    corner and the half pitch, as cos and sin of their angles)."""
     rg = lp[LP_SEAT_RADIUS]
     rt = lp[LP_TIP_RADIUS]
     rpin = lp[LP_PIN_RADIUS]
     alpha = lp[LP_FLANK_ANGLE]
     rs = seat_centre_radius(lp[LP_PITCH_RADIUS], rg, rpin)
-    r = math.sqrt(dx * dx + dy * dy)
-    if r >= rt + rpin:
-        return -1.0, 0.0, 0.0, False
     pitch = 2.0 * math.pi / lp[LP_TEETH]
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    t_end = flank_length(rs, rg, rt, alpha)        # the flank from (0, rg) along (cos, sin) alpha
+    corner = math.atan2(rg + t_end * sa, rs + t_end * ca)
+    return (rg, rt, rpin, rs, pitch, ca, sa, math.tan(alpha), t_end, math.cos(corner), math.sin(corner),
+            math.cos(0.5 * pitch), math.sin(0.5 * pitch))
+
+
+@njit(**INLINE)
+def _tip_point(ox, oy, shape):
+    """Nearest point to (ox, oy) (seen from the axis, the gap along x, oy >= 0) of the tooth
+    top: the tip circle's arc from the flank's corner to the half pitch."""
+    rt = shape[1]
+    cc, sc, ch, sh = shape[9], shape[10], shape[11], shape[12]
+    ro = math.sqrt(ox * ox + oy * oy)
+    if ro == 0.0 or cc * oy - sc * ox < 0.0:      # at an angle before the corner
+        return rt * cc, rt * sc
+    if ch * oy - sh * ox > 0.0:                   # beyond the half pitch
+        return rt * ch, rt * sh
+    return rt * ox / ro, rt * oy / ro
+
+
+@njit(**INLINE)
+def _gap_nearest(a, b, shape):
+    """Nearest point of the profile to the point (a, b) in the frame of the nearest gap (a
+    along the gap's centre line from its seat centre, b across it, b >= 0: by symmetry one
+    side), as (squared distance, a, b) of that point; shape: tooth_shape."""
+    rg, rs, ca, sa, t_end = shape[0], shape[3], shape[5], shape[6], shape[8]
+    best, na, nb = math.inf, 0.0, 0.0
+    r = math.sqrt(a * a + b * b)
+    if a <= 0.0 and r > 0.0:        # the seat's half circle
+        best, na, nb = _nearer(best, na, nb, a, b, rg * a / r, rg * b / r)
+    best, na, nb = _nearer(best, na, nb, a, b, 0.0, rg)
+    t = min(max(a * ca + (b - rg) * sa, 0.0), t_end)   # along the flank
+    best, na, nb = _nearer(best, na, nb, a, b, t * ca, rg + t * sa)
+    tx, ty = _tip_point(rs + a, b, shape)
+    best, na, nb = _nearer(best, na, nb, a, b, tx - rs, ty)
+    return best, na, nb
+
+
+@njit(**INLINE)
+def _in_gap(a, b, rg, tan_alpha):
+    """Is the point (a, b >= 0) inside the gap's seat or between its flanks?"""
+    if a <= 0.0:
+        return a * a + b * b < rg * rg
+    return b < rg + a * tan_alpha
+
+
+@njit(**INLINE)
+def pin_on_teeth(dx, dy, angle, shape):
+    """A pin at (dx, dy) from the sprocket axis, the sprocket turned by angle (CCW):
+    (penetration, nx, ny, inside). The penetration is r_pin minus the distance to the
+    profile (contact where > 0), (nx, ny) the unit direction that pushes the pin out of
+    it; inside is True where the pin's centre lies inside a tooth (it went through).
+    shape: tooth_shape."""
+    rg, rt, rpin, rs, pitch, tan_alpha = shape[0], shape[1], shape[2], shape[3], shape[4], shape[7]
+    r2 = dx * dx + dy * dy
+    if r2 >= (rt + rpin) * (rt + rpin):   # most pins: far from the teeth
+        return -1.0, 0.0, 0.0, False
     k = math.floor((math.atan2(dy, dx) - angle) / pitch + 0.5)   # the nearest gap
     ga = angle + k * pitch
     ux = math.cos(ga)
@@ -88,11 +113,17 @@ def pin_on_sprocket(dx, dy, angle, lp):
     b = -dx * uy + dy * ux
     side = 1.0 if b >= 0.0 else -1.0
     b = abs(b)
-    inside = r < rt and not _in_gap(a, b, rg, alpha)
-    d2, na, nb = _gap_nearest(a, b, rs, rg, rt, alpha, pitch)
+    inside = r2 < rt * rt and not _in_gap(a, b, rg, tan_alpha)
+    d2, na, nb = _gap_nearest(a, b, shape)
     dist = math.sqrt(d2)
     if inside or dist == 0.0:
         return rpin + dist, 0.0, 0.0, inside
     ea = (a - na) / dist
     eb = side * (b - nb) / dist
     return rpin - dist, ea * ux - eb * uy, ea * uy + eb * ux, False
+
+
+@njit(**INLINE)
+def pin_on_sprocket(dx, dy, angle, lp):
+    """pin_on_teeth for one pin, the profile from lp (LP_*)."""
+    return pin_on_teeth(dx, dy, angle, tooth_shape(lp))

@@ -17,9 +17,10 @@ from ..model.index import nq_of
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
 from ..model.soil_force import remember_sinkage
-from ..model.rhs import contact_switch, rhs
+from ..model.rhs import rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
+from .events import first_contact_switch
 from .control import FAC_MAX, after_acceptance, after_rejection, before_step, counted, finish_stats, loop_start
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
@@ -174,14 +175,14 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
             th = 2.0
             if err == err and err > 0.0:
                 # a contact starting or ending inside the step: end the retry just after it
-                th = contact_switch(y, K[0], y_new, K[s], h, m, w, ev)
+                th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
             h, at_switch = after_rejection(h, err, expo, th, h_min)
             fac_max = 1.0
             continue
         if onset_in_step(m, w):
             # a contact whose law remembers its approach speed began inside the step:
             # end the step at the onset (if located before the end) and take it there
-            th = contact_switch(y, K[0], y_new, K[s], h, m, w, ev)
+            th = first_contact_switch(y, K[0], y_new, K[s], h, m, ev)
             if th < 1.0 and th * h > h_min:
                 rejected += 1
                 h *= th

@@ -12,5 +12,6 @@ def run(scenario, model, y0):
     tab = TABLEAUS[scenario["method"]].arrays()
     out = allocate_outputs(scenario, model, y0.size)
     lw = loop_arrays(tab.b.shape[0], y0.size, L.n_diag(model.nw, model.n_links))
-    integrate(y0, control(scenario), tab, model.arrays, model.work, event_arrays(model.nw, model.n_links), lw, out)
+    ev = event_arrays(model.nw, model.n_links, model.arrays.guides.shape[0] if model.closed else None)
+    integrate(y0, control(scenario), tab, model.arrays, model.work, ev, lw, out)
     return trimmed(scenario, out)
