@@ -218,11 +218,13 @@ def test_closed_run_attributes_describe_the_layout(rest):
 DRIVEN = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6}
 
 
-def test_traction_limit():
+@pytest.mark.parametrize("law", ["regularised", "bristle"])
+def test_traction_limit(law):
     """A drive torque above what mu x weight carries: the track slips, and the ground's
-    tractive force stays at or below mu x its normal force."""
+    tractive force stays at or below mu x its normal force, with either friction law."""
     sc = tb.Scenario.from_dict({**DRIVEN, "terrain": {"kind": "flat"}, "speed": 0.0, "drive.kind": "torque",
-                                "drive.torque": 60e3, "duration": 0.3, "output_interval": 1e-3})
+                                "drive.torque": 60e3, "duration": 0.3, "output_interval": 1e-3,
+                                "contact.friction_law": law})
     assert 60e3 / sc["sprocket.pitch_radius"] > 0.6 * 230e3
     ds = tb.simulate(sc)
     assert ds.attrs["status"] == "completed"

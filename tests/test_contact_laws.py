@@ -82,3 +82,53 @@ def test_regularised_friction_law():
     assert friction(0.5, 0.01, 1000.0, -10.0) == pytest.approx(500.0, rel=1e-6)
     assert friction(0.5, 0.01, 1000.0, 0.0) == 0.0
     assert abs(friction(0.5, 0.01, 1000.0, 0.001)) < 0.1 * 500.0   # below v_eps: a viscous law
+
+
+def test_bristle_friction_law():
+    """A spring and dashpot to the anchor, capped at mu p = k x limit either way."""
+    from trackbench.model.contact_force import bristle
+    k, c = 2e7, 4e4
+    assert bristle(1e-3, k, c, 1e-4, 0.0) == pytest.approx(-2e3)          # stuck: the spring
+    assert bristle(1e-3, k, c, 1e-4, 0.01) == pytest.approx(-2e3 - 400.0)  # and its dashpot
+    assert bristle(1e-3, k, c, 5e-3, 0.0) == pytest.approx(-2e4)          # beyond the limit: mu p
+    assert bristle(1e-3, k, c, -5e-3, 0.0) == pytest.approx(2e4)
+    assert bristle(1e-3, k, c, 0.0, -10.0) == pytest.approx(2e4)          # sliding fast: mu p
+    assert bristle(0.0, k, c, 1e-4, 1.0) == 0.0                            # no normal force, no friction
+
+
+def test_bristle_anchor_moves_only_as_the_rules_say():
+    """remember_grip: a pin that touched down anchors where it is; one within its slip limit
+    keeps its anchor; one beyond it drags the anchor to the limit behind it, along the
+    ground's tangent; one off the ground forgets its anchor."""
+    from collections import namedtuple
+
+    from trackbench.model import layout as L
+    from trackbench.model.contact_laws import FRICTION_BRISTLE
+    from trackbench.model.grip import remember_grip
+    M = namedtuple("M", ["par", "touchdown"])
+    W = namedtuple("W", ["apos", "grip"])
+    par = np.zeros(L.N_PAR)
+    par[L.P_FRICTION], par[L.P_FRICTION_LAW] = 0.5, FRICTION_BRISTLE
+    nan = np.nan
+    apos = np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0]])
+    anchor = np.array([[nan, nan], [1.9995, 0.0], [2.99, 0.0], [3.9, 0.0]])
+    s = math.sqrt(0.5)       # pin 2 on a 45 deg slope: its tangent (s, s)
+    grip = np.array([[1e-3, 1.0, 0.0], [1e-3, 1.0, 0.0], [1e-3, s, s], [nan, nan, nan]])
+    remember_grip(M(par, anchor), W(apos, grip))
+    np.testing.assert_allclose(anchor[0], [1.0, 0.0])               # touched down: anchored here
+    np.testing.assert_allclose(anchor[1], [1.9995, 0.0])            # within the limit: kept
+    stretch = 0.01 * s                                              # pin 2's stretch along the slope
+    moved = stretch - 1e-3
+    np.testing.assert_allclose(anchor[2], [2.99 + moved * s, moved * s])
+    assert (apos[2] - anchor[2]) @ [s, s] == pytest.approx(1e-3)    # dragged to the limit
+    assert np.isnan(anchor[3]).all()                                # off the ground: forgotten
+
+
+def test_bristle_sliding_track_feels_coulomb_friction():
+    """Every pin sliding at ~10 m/s: the bristle law gives mu p exactly, like the regularised
+    law far above v_eps."""
+    ds = tb.simulate(tb.Scenario.paper(**{"terrain": {"kind": "flat"}, "contact.friction": 0.3,
+                                          "contact.friction_law": "bristle", "duration": 0.05}))
+    late = ds.time.values > 0.01
+    np.testing.assert_allclose(ds.ground_force_x.values[late] / ds.ground_force_y.values[late], -0.3, rtol=1e-9)
+    assert float(abs(ds.energy_residual).max()) < 1e-6

@@ -83,6 +83,8 @@ def test_restitution_laws_on_the_vehicle(law):
     ({"contact.friction": -0.1}, "contact.friction"),
     ({"contact.friction_velocity": 0.0}, "contact.friction_velocity"),
     ({"contact.friction": 0.5, "solver": "lee"}, "contact.friction"),
+    ({"contact.friction_law": "stribeck"}, "one of regularised, bristle"),
+    ({"contact.friction_stiffness": 0.0}, "contact.friction_stiffness"),
 ])
 def test_bad_damping_input_is_one_line(bad, words):
     with pytest.raises(ScenarioError) as e:

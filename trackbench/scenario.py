@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model.contact_laws import DAMPINGS, GEOMETRIES, LAWS
+from .model.contact_laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
 
 from .model.layout import DRIVES
 from .model.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle, wheel_centres_body
@@ -106,6 +106,8 @@ RULES = {
     "contact.geometry": (str, tuple(GEOMETRIES), None, "one of " + ", ".join(GEOMETRIES)),
     "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
     "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
+    "contact.friction_law": (str, tuple(FRICTION_LAWS), None, "one of " + ", ".join(FRICTION_LAWS)),
+    "contact.friction_stiffness": _POS,
     "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
     "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
     "track.width": (float, 0.0, 10.0, "a number in (0, 10] m"),

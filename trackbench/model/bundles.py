@@ -8,6 +8,7 @@ from collections import namedtuple
 import numpy as np
 
 from . import layout as L
+from .contact_laws import FRICTION_BRISTLE
 
 # Fixed for a run, except the candidate lists (nbr, ref), which the contact search
 # refreshes as the track moves, and the counters.
@@ -28,8 +29,9 @@ ModelArrays = namedtuple("ModelArrays", [
     "guides",     # (n_guides, N_G_COLS) idler (row 0) and support rollers, G_*; no rows for the paper's
     "rut",        # (n_cells,) the soil's memory: deepest sinkage reached in each cell along x (m);
                   # empty on rigid ground (P_RUT_X0, P_RUT_DX place the cells)
-    "touchdown",  # (n_pins, 2) where each pin last touched the soil (NaN: off it), for its shear
-                  # displacement; no rows on rigid ground
+    "touchdown",  # (n_pins, 2) soft soil: where each pin touched the soil, for its shear displacement;
+                  # bristle friction: where its bristle is anchored on the ground; NaN: off the
+                  # ground or touched down in the last step. No rows for neither.
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -47,6 +49,8 @@ Work = namedtuple("Work", [
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
     "sink",       # (n_pins,) each pin's sinkage into soft soil at the last evaluation (m; 0 off it)
+    "grip",       # (n_pins, 3) bristle friction at the last evaluation: the bristle's slip limit
+                  # mu p / k_t (m) and the ground's unit tangent; NaN off the ground
 ])
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
@@ -83,7 +87,11 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None,
                        np.ascontiguousarray(loop if closed else np.zeros(0), dtype=float),
                        np.ascontiguousarray(guides, dtype=float).reshape(-1, L.N_G_COLS),
                        np.zeros(0) if rut is None else np.ascontiguousarray(rut, dtype=float),
-                       np.full((0 if rut is None else n_links + 1, 2), np.nan))
+                       np.full((n_links + 1 if rut is not None or _bristle(par) else 0, 2), np.nan))
+
+
+def _bristle(par):
+    return par[L.P_FRICTION] > 0.0 and par[L.P_FRICTION_LAW] == FRICTION_BRISTLE
 
 
 def work_arrays(m, n_wheels, n_links):
@@ -93,7 +101,8 @@ def work_arrays(m, n_wheels, n_links):
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
             np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
-            np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins))
+            np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins),
+            np.full((n_pins, 3), np.nan))
     if not closed:
         return Work(*base)
     ng = m.guides.shape[0]

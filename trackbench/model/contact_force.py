@@ -41,3 +41,14 @@ def normal_force(law, delta, delta_dot, v0):
         f = f_el * (1.0 + chi * delta_dot / v0)
     f = max(f, 0.0)
     return f, energy, (f - f_el) * delta_dot
+
+
+@njit(**SCALAR)
+def bristle(limit, k, c, d, v_t):
+    """Bristle friction of a contact whose bristle (a tangential spring k with a dashpot c
+    to an anchor on the ground) is stretched by d and slides at v_t: -k d - c v_t, never
+    beyond the Coulomb force mu p = k limit. In stick the pin rides on the spring, whose
+    frequency an explicit step resolves, where the regularised law's slope mu p / v_eps
+    is a stiff damper; the anchor slips (model/grip.py) where the spring exceeds mu p."""
+    f_max = k * limit
+    return min(max(-k * d - c * v_t, -f_max), f_max)

@@ -39,6 +39,12 @@ GEOMETRY_PAPER = 0        # model.md: a link where the foot lies on it, else the
 GEOMETRY_CONTINUOUS = 1   # the union of link pads with round caps at the pins (gaps.pin_cap_weight)
 GEOMETRIES = {"paper": GEOMETRY_PAPER, "continuous": GEOMETRY_CONTINUOUS}
 
+# Friction between the track's pins and rigid ground (beyond_paper.md, "Friction")
+FRICTION_REGULARISED = 0  # -mu p v_t / sqrt(v_t^2 + v_eps^2): no memory, stiff in stick
+FRICTION_BRISTLE = 1      # a tangential spring to an anchor on the ground that slips at mu p
+FRICTION_LAWS = {"regularised": FRICTION_REGULARISED, "bristle": FRICTION_BRISTLE}
+BRISTLE_DAMPING_RATIO = 1.0   # the bristle's dashpot: critical for one pin on its spring
+
 
 def restitution_factor(damping, e):
     """The factor chi of F = K d^n (1 + chi d'/v0) for a restitution-based law."""

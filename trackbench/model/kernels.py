@@ -18,6 +18,7 @@ from .gaps import (ground_distance, link_frames, pin_cap_weight, pin_ground_sele
                    point_on_segment, segment_coords)
 from .contact_force import friction, normal_force
 from .soil_force import pin_on_soil, soil_shear
+from .grip import G_LIMIT, pin_grip, uses_bristle
 from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
@@ -402,12 +403,15 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     on_soil = par[P_SOIL] != 0.0
-    rut, touchdown, sink = soil
+    bristle = uses_bristle(par)
+    rut, touchdown, sink, grip = soil
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, last + 1):
         row = first + b
         if on_soil:
             sink[b] = 0.0
+        if bristle:
+            grip[b, G_LIMIT] = np.nan
         if nbr[row, NB_COUNT] == 0:    # no ground within reach (the closed track's top run): no call
             continue
         if continuous:
@@ -443,6 +447,11 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
                 force = (p * nx, p * ny, p, e, pd)
+                if bristle:     # the bristle instead of the regularised law
+                    ft, fd = pin_grip(b, apos, avel, (ny, -nx), p, par, touchdown, grip)
+                    force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
+                    dissipation += fd
+                    fr = (0.0, v_eps)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
             acc = _push_pin(fpin, avel, b, force, (0.0, 0.0), (ny, -nx), fr, acc, (0.0, p if sj > 0 else 0.0))
             gx, gy, corner_force, energy, power, obstacle, dissipation = acc
@@ -469,7 +478,7 @@ def _corners(w, m, diag, mem, acc):
 def ground_contacts(w, m, diag, mem):
     """The track against the ground: pins on segments, then the corners."""
     acc = _pins_on_ground(w.apos, w.avel, w.fpin, m.pins[PN_LAST], m.par, m.seg, m.nbr, m.nbr_rows, mem,
-                          (m.rut, m.touchdown, w.sink),
+                          (m.rut, m.touchdown, w.sink, w.grip),
                           (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
     gx, gy, corner_force, energy, power, obstacle, dissipation = _corners(w, m, diag, mem, acc)
     diag[D_E_PAD_GROUND] = energy

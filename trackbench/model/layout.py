@@ -275,7 +275,11 @@ P_RUT_DX = 34            # cell width (m)
 P_SOIL_COHESION = 35     # cohesion x the pin's area, c A (N)
 P_SOIL_TAN_PHI = 36      # tan of the soil's friction angle
 P_SOIL_SHEAR_K = 37      # shear deformation modulus K of Janosi-Hanamoto (m)
-N_PAR = 38
+# the bristle friction law (contact_laws.FRICTION_BRISTLE): spring and dashpot per ground contact
+P_FRICTION_LAW = 38      # FRICTION_* code
+P_BRISTLE_K = 39         # tangential stiffness k_t (N/m)
+P_BRISTLE_C = 40         # its dashpot, 2 zeta sqrt(k_t m_pin) (N s/m)
+N_PAR = 41
 
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point

@@ -10,7 +10,8 @@ import math
 import numpy as np
 
 from . import layout as L
-from .contact_laws import DAMPING_VISCOUS, DAMPINGS, GEOMETRIES, LAWS, restitution_factor
+from .contact_laws import BRISTLE_DAMPING_RATIO, DAMPING_VISCOUS, DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS, \
+    restitution_factor
 
 
 def paper_vehicle():
@@ -111,6 +112,8 @@ def paper_contact():
         "geometry": "paper",              # or "continuous"
         "friction": 0.0,                  # Coulomb mu between ground and track (0: the paper)
         "friction_velocity": 0.01,        # regularising speed of the friction law (m/s)
+        "friction_law": "regularised",    # or "bristle": a spring to an anchor that slips at mu p
+        "friction_stiffness": 2.0e7,      # the bristle's tangential stiffness per pin contact (N/m)
     }
 
 
@@ -152,6 +155,9 @@ def _pack_contact(par, contact):
     par[L.P_CONTACT_GEOMETRY] = GEOMETRIES[contact["geometry"]]
     par[L.P_FRICTION] = contact["friction"]
     par[L.P_FRICTION_VELOCITY] = contact["friction_velocity"]
+    par[L.P_FRICTION_LAW] = FRICTION_LAWS[contact["friction_law"]]
+    par[L.P_BRISTLE_K] = contact["friction_stiffness"]
+    par[L.P_BRISTLE_C] = 2.0 * BRISTLE_DAMPING_RATIO * math.sqrt(contact["friction_stiffness"] * par[L.P_PIN_MASS])
 
 
 def pack(vehicle, track, gravity, contact=None):

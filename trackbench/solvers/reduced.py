@@ -16,6 +16,7 @@ from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.index import nq_of
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
+from ..model.grip import remember_grip
 from ..model.soil_force import remember_sinkage
 from ..model.rhs import rhs
 from ..status import NAN, SUCCESSFUL
@@ -102,6 +103,7 @@ def _start(y0, m, w, lw, out):
     update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[2 * nq + Y_WORK], e_ref, r_ref, False)
     remember_onsets(m, w)
     remember_sinkage(m, w)
+    remember_grip(m, w)
     set_row(out.y, 0, lw.y)
     set_row(out.diag, 0, lw.diag)
     if lw.diag[D_STATUS] != 0.0:
@@ -195,7 +197,8 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
-        remember_sinkage(m, w)      # the soil's memory: from the accepted end state only
+        remember_sinkage(m, w)      # the soil's and the bristles' memory: from the accepted end state only
+        remember_grip(m, w)
         n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
         n_rhs += n_new - n_out
         n_out = n_new

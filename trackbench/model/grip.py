@@ -1,0 +1,70 @@
+"""Bristle friction between the track's pins and rigid ground, compiled: each pin on the
+ground holds a bristle, a tangential spring to an anchor (ModelArrays.touchdown) that
+stays where the pin touched down while the spring carries less than mu p, and is dragged
+along, mu p / k_t behind the pin, while it slides. The anchor moves only after an accepted
+step (remember_grip), so a rejected step leaves no trace; within a step the force is the
+spring's, capped at mu p (contact_force.bristle), a continuous function of the state."""
+
+import math
+
+from numba import njit
+
+from .contact_force import bristle
+from .contact_laws import FRICTION_BRISTLE
+from .jit import BORROW, INLINE
+from .layout import P_BRISTLE_C, P_BRISTLE_K, P_FRICTION, P_FRICTION_LAW
+
+G_LIMIT, G_TX, G_TY = 0, 1, 2    # columns of Work.grip
+
+
+@njit(**INLINE)
+def uses_bristle(par):
+    return par[P_FRICTION] > 0.0 and par[P_FRICTION_LAW] == FRICTION_BRISTLE
+
+
+@njit(**INLINE)
+def bristle_stretch(b, apos, anchor, tx, ty):
+    """How far pin b is from its anchor along the ground's unit tangent (0: no anchor yet,
+    the pin touched down in this step)."""
+    if anchor[b, 0] != anchor[b, 0]:
+        return 0.0
+    return (apos[b, 0] - anchor[b, 0]) * tx + (apos[b, 1] - anchor[b, 1]) * ty
+
+
+@njit(**INLINE)
+def pin_grip(b, apos, avel, t, p, par, anchor, grip):
+    """(friction force along the unit tangent t, its dissipated power) of pin b pressed on
+    the ground with normal force p; keeps the slip limit and t in grip for remember_grip."""
+    tx, ty = t
+    k = par[P_BRISTLE_K]
+    limit = par[P_FRICTION] * p / k
+    grip[b, G_LIMIT] = limit
+    grip[b, G_TX] = tx
+    grip[b, G_TY] = ty
+    v_t = avel[b, 0] * tx + avel[b, 1] * ty
+    f = bristle(limit, k, par[P_BRISTLE_C], bristle_stretch(b, apos, anchor, tx, ty), v_t)
+    return f, -f * v_t
+
+
+@njit(**BORROW)
+def remember_grip(m, w):
+    """After an accepted step (the last evaluation was at its end): a pin that touched down
+    anchors its bristle where it is, one whose spring went beyond mu p drags its anchor to
+    mu p / k_t behind it, one that left the ground forgets its anchor."""
+    if not uses_bristle(m.par):
+        return
+    anchor, grip = m.touchdown, w.grip
+    for b in range(grip.shape[0]):
+        limit = grip[b, G_LIMIT]
+        if limit != limit:
+            anchor[b, 0] = math.nan
+            anchor[b, 1] = math.nan
+        elif anchor[b, 0] != anchor[b, 0]:
+            anchor[b, 0] = w.apos[b, 0]
+            anchor[b, 1] = w.apos[b, 1]
+        else:
+            d = bristle_stretch(b, w.apos, anchor, grip[b, G_TX], grip[b, G_TY])
+            if abs(d) > limit:
+                slide = d - math.copysign(limit, d)
+                anchor[b, 0] += slide * grip[b, G_TX]
+                anchor[b, 1] += slide * grip[b, G_TY]
