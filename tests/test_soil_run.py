@@ -98,3 +98,14 @@ def test_soil_on_a_lee_run_is_refused():
 def test_soil_on_any_terrain_shape():
     sc = tb.Scenario.from_dict({"terrain.soil": "sandy_loam"})
     assert sc["terrain"]["kind"] == "step" and sc["terrain"]["soil"] == "sandy_loam"
+
+
+def test_bristle_friction_leaves_the_soil_shear_alone():
+    """On soft soil Janosi-Hanamoto's shear replaces friction: the bristle law changes
+    nothing there (its anchors would be the soil's touchdown points)."""
+    base = {"terrain": {"kind": "flat", "soil": "lete_sand"}, "contact.friction": 0.6, "duration": 0.02,
+            "output_interval": 1e-3}
+    a = tb.simulate(tb.Scenario.paper(**base))
+    b = tb.simulate(tb.Scenario.paper(**base, **{"contact.friction_law": "bristle"}))
+    np.testing.assert_array_equal(a.ground_force_x.values, b.ground_force_x.values)
+    np.testing.assert_array_equal(a.chassis_x.values, b.chassis_x.values)

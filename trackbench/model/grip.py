@@ -12,14 +12,15 @@ from numba import njit
 from .contact_force import bristle
 from .contact_laws import FRICTION_BRISTLE
 from .jit import BORROW, INLINE
-from .layout import P_BRISTLE_C, P_BRISTLE_K, P_FRICTION, P_FRICTION_LAW
+from .layout import P_BRISTLE_C, P_BRISTLE_K, P_FRICTION, P_FRICTION_LAW, P_SOIL
 
 G_LIMIT, G_TX, G_TY = 0, 1, 2    # columns of Work.grip
 
 
 @njit(**INLINE)
 def uses_bristle(par):
-    return par[P_FRICTION] > 0.0 and par[P_FRICTION_LAW] == FRICTION_BRISTLE
+    """On soft soil the soil's shear replaces friction and the anchors are the soil's."""
+    return par[P_FRICTION] > 0.0 and par[P_FRICTION_LAW] == FRICTION_BRISTLE and par[P_SOIL] == 0.0
 
 
 @njit(**INLINE)
