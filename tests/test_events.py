@@ -20,36 +20,36 @@ from trackbench.solvers.events import _gap_end
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
 
 
-def _weight(kind, i, b, m, pins, wheels, continuous):
-    """How often the pair counts: a pin's cap by gaps.pin_cap_weight; in the continuous
-    geometry a pin meets the ground once (every candidate segment gives the same gap)."""
+def _weight(kind, i, b, m, pins, probes, continuous):
+    """How often the pair counts: a pin's cap (probes: each pin kind's probe positions) by
+    gaps.pin_cap_weight; in the continuous geometry a pin meets the ground once (every
+    candidate segment gives the same gap)."""
     if kind == L.K_PIN_GROUND:
         return 1 if not continuous or b == m.nbr[m.nbr_rows[kind] + i, 1] else 0
-    if kind not in (L.K_WHEEL_PIN, L.K_CORNER_PIN):
+    if kind not in probes:
         return 1
-    p = wheels[i] if kind == L.K_WHEEL_PIN else m.corners[i]
+    p = probes[kind][i]
     t0 = (pins[b] - pins[b - 1]) / np.linalg.norm(pins[b] - pins[b - 1])
     t1 = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
-    return pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1], kind == L.K_WHEEL_PIN,
+    return pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1], kind != L.K_CORNER_PIN,
                           continuous)
 
 
-def _event_energy(m, w, par):
+def _event_energy(m, ev, pins, probes):
     """Pad energies (wheel side, ground side) over the pairs the event location calls
-    active, each as often as it counts (_weight)."""
-    place_pins, place_wheels = w.apos.copy(), w.wc.copy()
-    ev = EventWork(place_pins, place_pins, place_wheels, place_wheels, w.arm.copy())
-    continuous = par[L.P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
+    active (its scratch ev placed at the state), each as often as it counts (_weight);
+    pins: the pin positions with the one after the last."""
+    continuous = m.par[L.P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
     energy = {"wheel": 0.0, "ground": 0.0}
     for kind in range(L.N_KINDS):
-        k = par[L.P_K_GROUND] if kind in GROUND_KINDS else par[L.P_K_WHEEL]
+        k = m.par[L.P_K_GROUND] if kind in GROUND_KINDS else m.par[L.P_K_WHEEL]
         for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, L.NB_COUNT]):
                 b = m.nbr[row, 1 + j]
                 valid, gap = _gap_end(kind, i, b, 0, m, ev)
                 if valid and gap > 0.0:
-                    weight = _weight(kind, i, b, m, place_pins, place_wheels, continuous)
+                    weight = _weight(kind, i, b, m, pins, probes, continuous)
                     energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
     return energy
 
@@ -81,7 +81,8 @@ def test_event_contact_decision_equals_the_kernels(geometry, request):
             if d[L.D_STATUS] != 0.0:
                 continue   # a wheel or corner through the track: the run would stop here
             place(y[:nq], m.par, m.arms, m.ends, w.apos, w.wc, w.arm)
-            e = _event_energy(m, w, m.par)
+            ev = EventWork(w.apos, w.apos, w.wc, w.wc, w.arm)
+            e = _event_energy(m, ev, w.apos, {L.K_WHEEL_PIN: w.wc, L.K_CORNER_PIN: m.corners})
             assert e["wheel"] == pytest.approx(d[L.D_E_PAD_WHEEL], rel=1e-9, abs=1e-9)
             assert e["ground"] == pytest.approx(d[L.D_E_PAD_GROUND], rel=1e-9, abs=1e-9)
             checked["wheel"] += e["wheel"] > 0
@@ -119,27 +120,9 @@ def test_closed_event_contact_decision_equals_the_kernels():
         if d[L.D_STATUS] != 0.0:
             continue
         place_loop(y[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
-        energy = {"wheel": 0.0, "ground": 0.0}
         pins = np.vstack([ev.pins0, ev.pins0[1]])          # pin 1 after pin n_links
-        for kind in range(L.N_KINDS):
-            k = m.par[L.P_K_GROUND] if kind in GROUND_KINDS else m.par[L.P_K_WHEEL]
-            for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
-                i = row - m.nbr_rows[kind]
-                for j in range(m.nbr[row, L.NB_COUNT]):
-                    b = m.nbr[row, 1 + j]
-                    valid, gap = _gap_end(kind, i, b, 0, m, ev)
-                    if valid and gap > 0.0:
-                        weight = 1
-                        if kind == L.K_PIN_GROUND:       # continuous geometry: one contact per pin
-                            weight = int(b == m.nbr[row, 1])
-                        elif kind in (L.K_WHEEL_PIN, L.K_GUIDE_PIN, L.K_CORNER_PIN):
-                            probes = {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0, L.K_CORNER_PIN: m.corners}
-                            p = probes[kind][i]
-                            t0 = (pins[b] - pins[b - 1]) / np.linalg.norm(pins[b] - pins[b - 1])
-                            t1 = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
-                            weight = pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1],
-                                                    kind != L.K_CORNER_PIN, True)
-                        energy["ground" if kind in GROUND_KINDS else "wheel"] += weight * 0.5 * k * gap * gap
+        energy = _event_energy(m, ev, pins, {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0,
+                                             L.K_CORNER_PIN: m.corners})
         teeth = 0.0
         for b in range(1, n + 1):
             g = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], (y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH], y[i_s]), m.loop,
