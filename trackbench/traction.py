@@ -8,6 +8,16 @@ ground's net horizontal force on the track (`drawbar_pull`) is the sum of the so
 forces' x components: the gross thrust. The soil's compaction is paid through the sprocket
 instead (a deeper rut is more work of the pins' pressure), so it shows as sprocket pull
 (torque / pitch radius) beyond the thrust, not as a horizontal ground force.
+
+Two slips: `slip`, the run's output, is 1 - chassis speed / (sprocket speed x pitch radius),
+the one the towing rig holds; `track_slip` is the slip the soil sees, 1 - chassis speed / the
+track's own speed relative to the chassis in the contact, measured on the pins (Wong's
+i = j / x: the shear displacement per length of track run past). They differ by the
+sprocket's chordal action (the pins ride a polygon: one pitch p per tooth, a mean track speed
+omega N p / (2 pi) = 0.984 omega r_p for 10 teeth, 1.6 % of slip) and by the links' stretch
+(a link under tension T is L + T / k long; the teeth are spaced for track.tension): with the
+paper's soft links the ground run's tension rises from the front of the contact to the rear,
+and with it the pins' slip (docs/validation.md). Wong's form is evaluated at `track_slip`.
 """
 
 import json
@@ -33,8 +43,9 @@ def has_traction(ds):
 
 
 def steady(ds, since):
-    """Means over t >= since: slip, thrust (N), drawbar load at the hitch (N), sprocket pull
-    (N), ground's vertical force W (N), pins in contact, contact length l (m) and area A (m^2)."""
+    """Means over t >= since: slip (the sprocket's), track_slip (the soil's: track_slip()),
+    thrust (N), drawbar load at the hitch (N), sprocket pull (N), ground's vertical force W (N),
+    pins in contact, contact length l (m) and area A (m^2)."""
     sc = _scenario(ds)
     late = ds.time.values >= since
     pitch_radius = json.loads(ds.attrs["closed_layout"])["pitch_radius"]
@@ -43,6 +54,7 @@ def steady(ds, since):
     length = n * sc["track"]["link_length"]    # each pin stands for one link's length of ground
     return {
         "slip": float(np.nanmean(ds.slip.values[late])),
+        "track_slip": track_slip(ds, since),
         "thrust": float(ds.drawbar_pull.values[late].mean()),
         "drawbar_load": float(ds.drawbar_load.values[late].mean()) if "drawbar_load" in ds else float("nan"),
         "sprocket_pull": float(ds.sprocket_torque.values[late].mean()) / pitch_radius,
@@ -53,11 +65,28 @@ def steady(ds, since):
     }
 
 
+def track_slip(ds, since):
+    """The slip the soil sees over t >= since: the pins' mean speed backwards over the ground
+    divided by their mean speed relative to the chassis (chassis speed + that), over the pins
+    on the soil at two successive samples (their speed: the difference of their x); NaN
+    without any."""
+    t = ds.time.values
+    pair = t[:-1] >= since
+    on = (ds.sinkage.values[:-1] > 0.0) & (ds.sinkage.values[1:] > 0.0) & pair[:, None]
+    if not on.any():
+        return float("nan")
+    ground = np.diff(ds.pin_x.values, axis=0) / np.diff(t)[:, None]
+    chassis = 0.5 * (ds.chassis_vx.values[:-1] + ds.chassis_vx.values[1:])[:, None]
+    backwards = -ground[on].sum()
+    return float(backwards / (np.broadcast_to(chassis, on.shape)[on].sum() + backwards))
+
+
 def wong(fig, soil):
-    """Wong's thrust of a track of the run's contact length, area and weight at its slip,
+    """Wong's thrust of a track of the run's contact length, area and weight at the slip its
+    soil sees (track_slip),
     and his compaction resistance b k z0^(n+1) / (n+1) at the sinkage z0 of the uniform
     pressure W / A (Theory of Ground Vehicles): (thrust, resistance) in N."""
-    thrust = wong_thrust(fig["area"], fig["weight"], fig["length"], min(max(fig["slip"], 0.0), 1.0), soil)
+    thrust = wong_thrust(fig["area"], fig["weight"], fig["length"], min(max(fig["track_slip"], 0.0), 1.0), soil)
     b = fig["area"] / fig["length"]
     z0 = static_sinkage(fig["weight"] / fig["area"], soil, b)
     resistance = b * float(bekker_pressure(z0, soil, b)) * z0 / (soil["n"] + 1.0)

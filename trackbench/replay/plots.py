@@ -401,8 +401,9 @@ def _steady_point(ds):
 def _plot_drawbar_pull(src, ok, out):
     """Drawbar pull against slip, one curve per soil, when the study's completed runs drive
     the closed track on soft soil (study_drawbar_pull.png), and, for runs held by a drawbar,
-    Wong's thrust of a uniformly loaded track of each run's contact and weight (dashed; on flat
-    soil the drawbar pull is the thrust: trackbench/traction.py); None otherwise."""
+    Wong's thrust of a uniformly loaded track of each run's contact and weight at the slip its
+    soil sees (dashed; on flat soil the drawbar pull is the thrust: trackbench/traction.py);
+    None otherwise."""
     import xarray as xr
     points = []
     for rid in ok.get("run_id", []):
