@@ -279,13 +279,46 @@ def _continuation(P, u, target, max_iter, step=0.05):
     return u, norm, it
 
 
+def _uniform_sinkage(P, pins_on_soil):
+    """Bekker's sinkage under the weight spread evenly over that many pins' areas."""
+    p = P.weight / (pins_on_soil * P.par[L.P_PIN_AREA])
+    return (p / P.par[L.P_SOIL_K]) ** (1.0 / P.par[L.P_SOIL_N])
+
+
+def _soil_continuation(P, u, target, max_iter, step=0.05):
+    """Soft soil with Bekker's n != 1: Newton's method through a chain of laws
+    k z0^(n - m) z^m, m from 1 to n (z0 the first guess of the sinkage, so that every law of
+    the chain carries the weight at about the same depth), each solution (rounded where
+    Newton's method stalls) starting the next."""
+    n, k = P.par[L.P_SOIL_N], P.par[L.P_SOIL_K]
+    z0 = _uniform_sinkage(P, max(int(P.n_links) // 2, 1))
+    it = 0
+    norm = np.inf
+    for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
+        P.par[L.P_SOIL_N] = m
+        P.par[L.P_SOIL_K] = k * z0 ** (n - m)
+        tol = target if m == n else 1e-6 * P.weight
+        u, norm, j = _newton(P, u, tol, max_iter)
+        u, norm, j2 = _rounded(P, u, norm, 0, tol, max_iter)
+        it += j + j2
+    P.par[L.P_SOIL_N], P.par[L.P_SOIL_K] = n, k     # exactly the scenario's law again
+    return u, norm, it
+
+
 def _solve(P, u, max_iter, tol_rel, failure, check):
-    """Newton's method (by continuation for a power law), rounded where it stalls; the
-    solution and the iteration count, or EquilibriumError above 1e-6 of the weight."""
+    """Newton's method (by continuation for a power law or Bekker's soil), rounded where it
+    stalls; the solution and the iteration count, or EquilibriumError above 1e-6 of the weight."""
     target = tol_rel * P.weight
-    u, norm, it = _continuation(P, u, target, max_iter)
+    if P.par[L.P_SOIL] != 0.0 and P.par[L.P_SOIL_N] != 1.0:
+        u, norm, it = _soil_continuation(P, u, target, max_iter)
+    else:
+        u, norm, it = _continuation(P, u, target, max_iter)
     u, norm, it = _rounded(P, u, norm, it, target, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
+        if P.par[L.P_SOIL] != 0.0:     # most often a soil too soft for the vehicle: say how soft
+            on = max(int(np.count_nonzero(P.work.sink > 0.0)), 1)
+            check = (f"the soil: spread evenly over the {on} pins on it, the weight sinks the track "
+                     f"{_uniform_sinkage(P, on):.3g} m (Bekker); a wider track.width or a firmer soil sinks less")
         raise EquilibriumError(f"{failure}: force residual {norm:.3g} N after {it} Newton iterations (needs < "
                                f"{1e-6 * P.weight:.3g} N); check {check}")
     return u, it
