@@ -29,10 +29,13 @@ def run(
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
     from .runner import run_one
     from .scenario import ScenarioError
+    from .status import EquilibriumError
     try:
         text, ok = run_one(set_, duration, out, name, force, storage)
     except ScenarioError as e:
         _fail(str(e))
+    except EquilibriumError as e:      # no start: nothing written
+        _fail(str(e), 1)
     typer.echo(text)
     if not ok:
         raise typer.Exit(1)

@@ -3,6 +3,10 @@
 from enum import IntEnum
 
 
+class EquilibriumError(RuntimeError):
+    """The static equilibrium a run starts from was not found: the run cannot start."""
+
+
 class Result(IntEnum):
     SUCCESSFUL = 0
     NAN = 1

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from ..status import EquilibriumError
 from . import layout as L
 from .index import n_coordinates, n_state, pin_offset, q_idler, q_sprocket
 from .jit import KERNEL
@@ -23,8 +24,6 @@ from .terrain import flat_ground
 from .track_path import initial_track
 
 
-class EquilibriumError(RuntimeError):
-    pass
 
 
 @dataclass
