@@ -85,13 +85,16 @@ def _drawbar_run(slip, duration, since):
     return fig, wong(fig, run_soil(ds))[0], [h["thrust"] / h["weight"] for h in halves]
 
 
-@pytest.mark.parametrize("slip, duration, since", [(0.05, 3.0, 2.0), (0.3, 1.2, 0.6)])
+@pytest.mark.parametrize("slip, duration, since", [(0.05, 4.0, 2.0), (0.3, 1.2, 0.6)])
 def test_thrust_against_slip_matches_wong_within_5_percent(slip, duration, since):
     """Gross thrust (the soil shear's x, = drawbar_pull on flat soil) of the vehicle held at a
     slip by the towing rig, against Wong's closed form for a uniformly loaded track of the
     same contact length, area and weight at the slip the soil sees (traction.track_slip):
-    within 5 %, and steady: thrust / W alike (2 %) over the two halves of the window (W
-    swings with the vehicle's bounce at high slip, the thrust with it). The rig holds the
+    within 5 %, and steady: thrust / W alike (5 %) over the two halves of the window (W
+    swings with the vehicle's bounce at high slip, the thrust with it; at 5 % set, the halves
+    of 2-4 s differed by -2.5 % to +1.1 % over five runs nudged by 1e-9 m, the motion being
+    chaotic, while a thrust still settling, as with the paper's links, rises 10-60 % from one
+    half to the next). The rig holds the
     sprocket's slip to 0.02 of the set one, and the drawbar takes the thrust (steady: the
     mean horizontal momentum does not change). Stiff links, as Wong's inextensible track:
     the paper's (8e6 N/m) stretch with the ground run's tension, so that the front of the
@@ -101,7 +104,7 @@ def test_thrust_against_slip_matches_wong_within_5_percent(slip, duration, since
     fig, f_wong, halves = _drawbar_run(slip, duration, since)
     assert fig["slip"] == pytest.approx(slip, abs=0.02)
     assert fig["drawbar_load"] == pytest.approx(fig["thrust"], rel=0.03)
-    assert halves[1] == pytest.approx(halves[0], rel=0.02)
+    assert halves[1] == pytest.approx(halves[0], rel=0.05)
     assert fig["thrust"] == pytest.approx(f_wong, rel=0.05)
 
 
