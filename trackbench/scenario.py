@@ -107,7 +107,7 @@ RULES = {
     "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
     "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
     "contact.friction_law": (str, tuple(FRICTION_LAWS), None, "one of " + ", ".join(FRICTION_LAWS)),
-    "contact.friction_stiffness": _POS,
+    "contact.friction_stiffness": (float, 0.0, math.inf, "a number > 0 (N/m: the bristle's tangential stiffness)"),
     "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
     "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
     "track.width": (float, 0.0, 10.0, "a number in (0, 10] m"),
@@ -150,7 +150,7 @@ RULES = {
 }
 _OPEN_LOW = {"duration", "drawbar.rig_damping", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent", "track.width",
              "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed",
-             "contact.friction_velocity"} | {
+             "contact.friction_velocity", "contact.friction_stiffness"} | {
     k for k, r in RULES.items() if r is _POS}
 
 TERRAIN_RULES = {
