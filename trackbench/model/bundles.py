@@ -8,7 +8,6 @@ from collections import namedtuple
 import numpy as np
 
 from . import layout as L
-from .contact_laws import FRICTION_BRISTLE
 
 # Fixed for a run, except the candidate lists (nbr, ref), which the contact search
 # refreshes as the track moves, and the counters.
@@ -31,7 +30,7 @@ ModelArrays = namedtuple("ModelArrays", [
                   # empty on rigid ground (P_RUT_X0, P_RUT_DX place the cells)
     "touchdown",  # (n_pins, 2) soft soil: where each pin touched the soil, for its shear displacement;
                   # bristle friction: where its bristle is anchored on the ground; NaN: off the
-                  # ground or touched down in the last step. No rows for neither.
+                  # ground or touched down in the last step
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -87,11 +86,7 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None,
                        np.ascontiguousarray(loop if closed else np.zeros(0), dtype=float),
                        np.ascontiguousarray(guides, dtype=float).reshape(-1, L.N_G_COLS),
                        np.zeros(0) if rut is None else np.ascontiguousarray(rut, dtype=float),
-                       np.full((n_links + 1 if rut is not None or _bristle(par) else 0, 2), np.nan))
-
-
-def _bristle(par):
-    return par[L.P_FRICTION] > 0.0 and par[L.P_FRICTION_LAW] == FRICTION_BRISTLE
+                       np.full((n_links + 1, 2), np.nan))
 
 
 def work_arrays(m, n_wheels, n_links):

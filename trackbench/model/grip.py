@@ -3,7 +3,9 @@ ground holds a bristle, a tangential spring to an anchor (ModelArrays.touchdown)
 stays where the pin touched down while the spring carries less than mu p, and is dragged
 along, mu p / k_t behind the pin, while it slides. The anchor moves only after an accepted
 step (remember_grip), so a rejected step leaves no trace; within a step the force is the
-spring's, capped at mu p (contact_force.bristle), a continuous function of the state."""
+spring's, capped at mu p (contact_force.bristle), a continuous function of the state. A pin
+on two segments at once (the paper's geometry at a concave corner) keeps one anchor, stretched
+along the tangent of the segment met last."""
 
 import math
 
