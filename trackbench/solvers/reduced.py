@@ -35,12 +35,30 @@ LoopWork = namedtuple("LoopWork", [
     "er5",    # (ny,) error estimate, 5th order
     "er3",    # (ny,) error estimate, 3rd order (DOP853)
     "diag",   # (n_diag,) diagnostics of the last evaluation
+    "end",    # EndOfStep: the ground's state at the end of the accepted step
 ])
 
+# What the soil's and the bristles' memories are moved from after an accepted step (Work's
+# fields of the same names, at the step's end), kept while the output samples inside the step
+# are evaluated: the step was integrated with the memories as they were before it, and so are
+# its samples.
+EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
 
-def loop_arrays(stages, ny, n_diag):
+
+def loop_arrays(stages, ny, n_diag, n_pins):
+    end = EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, 3), np.nan))
     return LoopWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
-                    np.empty(ny), np.empty(ny), np.empty(n_diag))
+                    np.empty(ny), np.empty(ny), np.empty(n_diag), end)
+
+
+@njit(**INLINE)
+def _keep_end(w, end):
+    for b in range(w.sink.shape[0]):
+        end.apos[b, 0] = w.apos[b, 0]
+        end.apos[b, 1] = w.apos[b, 1]
+        end.sink[b] = w.sink[b]
+        for k in range(3):
+            end.grip[b, k] = w.grip[b, k]
 
 
 @njit(**INLINE)
@@ -197,9 +215,10 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
-        remember_sinkage(m, w)      # the soil's and the bristles' memory: from the accepted end state only
-        remember_grip(m, w)
+        _keep_end(w, lw.end)
         n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
+        remember_sinkage(m, lw.end)     # the soil's and the bristles' memories: from the accepted end
+        remember_grip(m, lw.end)        # state only, after the samples inside the step
         n_rhs += n_new - n_out
         n_out = n_new
         t = t_new
