@@ -97,31 +97,47 @@ def test_bristle_friction_law():
 
 
 def test_bristle_anchor_moves_only_as_the_rules_say():
-    """remember_grip: a pin that touched down anchors where it is; one within its slip limit
-    keeps its anchor; one beyond it drags the anchor to the limit behind it, along the
-    ground's tangent; one off the ground forgets its anchor."""
+    """remember_grip: a pin that touched down anchors where it is; one whose force is below
+    mu p keeps its anchor (even with its spring beyond the limit, the dashpot holding it
+    back); one at mu p has its anchor dragged along the ground's tangent to where spring and
+    dashpot give that same force, so the force at the step's end does not change; one off
+    the ground forgets its anchor."""
     from collections import namedtuple
 
     from trackbench.model import layout as L
+    from trackbench.model.contact_force import bristle
     from trackbench.model.contact_laws import FRICTION_BRISTLE
-    from trackbench.model.grip import remember_grip
+    from trackbench.model.grip import bristle_stretch, remember_grip
+    from trackbench.model.layout import G_FORCE, G_LIMIT, G_SPEED, G_TX, G_TY, N_GRIP
     M = namedtuple("M", ["par", "touchdown"])
     W = namedtuple("W", ["apos", "grip"])
+    k, c, limit = 2e7, 4e4, 1e-3
     par = np.zeros(L.N_PAR)
-    par[L.P_FRICTION], par[L.P_FRICTION_LAW] = 0.5, FRICTION_BRISTLE
+    par[L.P_FRICTION], par[L.P_FRICTION_LAW], par[L.P_BRISTLE_K], par[L.P_BRISTLE_C] = 0.5, FRICTION_BRISTLE, k, c
     nan = np.nan
-    apos = np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0]])
-    anchor = np.array([[nan, nan], [1.9995, 0.0], [2.99, 0.0], [3.9, 0.0]])
-    s = math.sqrt(0.5)       # pin 2 on a 45 deg slope: its tangent (s, s)
-    grip = np.array([[1e-3, 1.0, 0.0], [1e-3, 1.0, 0.0], [1e-3, s, s], [nan, nan, nan]])
+    s = math.sqrt(0.5)       # pin 3 on a 45 deg slope: its tangent (s, s)
+    apos = np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0], [5.0, 0.0]])
+    anchor = np.array([[nan, nan], [1.9995, 0.0], [3.0 - 1.1e-3, 0.0], [4.0 - 0.01 * s, -0.01 * s], [4.9, 0.0]])
+    tangent = [(1.0, 0.0), (1.0, 0.0), (1.0, 0.0), (s, s), (nan, nan)]
+    speed = [0.0, 0.01, -0.3, 0.2, nan]   # pin 2: stretched beyond the limit, moving back: force below mu p
+    grip = np.full((5, N_GRIP), nan)
+    for b in range(4):
+        grip[b, G_LIMIT], (grip[b, G_TX], grip[b, G_TY]), grip[b, G_SPEED] = limit, tangent[b], speed[b]
+        d = bristle_stretch(b, apos, anchor, *tangent[b]) if b else 0.0
+        grip[b, G_FORCE] = bristle(limit, k, c, d, speed[b])
+    before = anchor.copy()
     remember_grip(M(par, anchor), W(apos, grip))
     np.testing.assert_allclose(anchor[0], [1.0, 0.0])               # touched down: anchored here
-    np.testing.assert_allclose(anchor[1], [1.9995, 0.0])            # within the limit: kept
-    stretch = 0.01 * s                                              # pin 2's stretch along the slope
-    moved = stretch - 1e-3
-    np.testing.assert_allclose(anchor[2], [2.99 + moved * s, moved * s])
-    assert (apos[2] - anchor[2]) @ [s, s] == pytest.approx(1e-3)    # dragged to the limit
-    assert np.isnan(anchor[3]).all()                                # off the ground: forgotten
+    np.testing.assert_array_equal(anchor[1], before[1])             # within the limit: kept
+    assert abs(grip[2, G_FORCE]) < k * limit
+    np.testing.assert_array_equal(anchor[2], before[2])             # below mu p though stretched: kept
+    assert grip[3, G_FORCE] == -k * limit                           # sliding: at mu p
+    after = bristle(limit, k, c, bristle_stretch(3, apos, anchor, s, s), speed[3])
+    assert after == pytest.approx(grip[3, G_FORCE], rel=1e-9)       # dragged: the same force
+    moved = anchor[3] - before[3]
+    assert moved[0] * s - moved[1] * s == pytest.approx(0.0, abs=1e-15)   # along the slope
+    assert (apos[3] - anchor[3]) @ [s, s] < 0.01                    # towards the pin
+    assert np.isnan(anchor[4]).all()                                # off the ground: forgotten
 
 
 def test_bristle_sliding_track_feels_coulomb_friction():

@@ -52,7 +52,7 @@ def test_equilibrium_on_every_soil_at_the_default_width(name, layout):
 def test_too_soft_soil_says_so():
     """Heavy clay (n = 0.11) under the paper's vehicle on a 0.5 m track: no equilibrium within
     the vehicle's reach, and the error says how deep the soil would let it sink."""
-    from trackbench.model.equilibrium import EquilibriumError
+    from trackbench.status import EquilibriumError
     with pytest.raises(EquilibriumError) as e:
         S.equilibrium(tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": "heavy_clay"}, "speed": 0.0}))
     assert "check the soil" in str(e.value) and "track.width" in str(e.value) and "\n" not in str(e.value)

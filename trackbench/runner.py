@@ -37,7 +37,9 @@ def _energy_line(ds, s):
     balance alone then falls by design), less what a drive put in."""
     dissipated = float(ds["energy_dissipated"][-1]) if "energy_dissipated" in ds else 0.0
     tail = f"; work residual {s['max_energy_residual']:.2e}"
-    if dissipated > 0.0:
+    if "drawbar_load" in ds and float(abs(ds["drawbar_load"]).max()) > 0.0:
+        tail += " (the drawbar's work is in the residual, not in the balance line)"
+    if dissipated > 0.0 or "drive_work" in ds:
         net = ds["energy_dissipated"].values - ds["energy_dissipated"].values[0]
         label, driven = "energy balance + dissipated      ", ""
         if "drive_work" in ds:

@@ -107,7 +107,7 @@ RULES = {
     "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
     "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
     "contact.friction_law": (str, tuple(FRICTION_LAWS), None, "one of " + ", ".join(FRICTION_LAWS)),
-    "contact.friction_stiffness": (float, 0.0, math.inf, "a number > 0 (N/m: the bristle's tangential stiffness)"),
+    "contact.friction_stiffness": (float, 0.0, 1e12, "a number in (0, 1e12] (N/m: the bristle's tangential stiffness)"),
     "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
     "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
     "track.width": (float, 0.0, 10.0, "a number in (0, 10] m"),

@@ -48,8 +48,9 @@ Work = namedtuple("Work", [
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
     "sink",       # (n_pins,) each pin's sinkage into soft soil at the last evaluation (m; 0 off it)
-    "grip",       # (n_pins, 3) bristle friction at the last evaluation: the bristle's slip limit
-                  # mu p / k_t (m) and the ground's unit tangent; NaN off the ground
+    "grip",       # (n_pins, N_GRIP) bristle friction at the last evaluation (layout.G_*): the slip
+                  # limit mu p / k_t (m), the ground's unit tangent, the force, the pin's speed
+                  # along the tangent; NaN off the ground
 ])
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
@@ -97,7 +98,7 @@ def work_arrays(m, n_wheels, n_links):
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
             np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
             np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins),
-            np.full((n_pins, 3), np.nan))
+            np.full((n_pins, L.N_GRIP), np.nan))
     if not closed:
         return Work(*base)
     ng = m.guides.shape[0]

@@ -252,9 +252,7 @@ def _soil_sinkage(P, pins):
     of the ground run (0 on rigid ground)."""
     if P.par[L.P_SOIL] == 0.0:
         return 0.0
-    on_ground = max(int(np.sum(pins[:, 1] < pins[:, 1].min() + 0.01)), 1)
-    p = P.weight / (on_ground * P.par[L.P_PIN_AREA])
-    return (p / P.par[L.P_SOIL_K]) ** (1.0 / P.par[L.P_SOIL_N])
+    return _uniform_sinkage(P, max(int(np.sum(pins[:, 1] < pins[:, 1].min() + 0.01)), 1))
 
 
 def _continuation(P, u, target, max_iter, step=0.05):
@@ -286,7 +284,7 @@ def _uniform_sinkage(P, pins_on_soil):
 
 def _soil_continuation(P, u, target, max_iter, step=0.05):
     """Soft soil with Bekker's n != 1: Newton's method through a chain of laws
-    k z0^(n - m) z^m, m from 1 to n (z0 the first guess of the sinkage, so that every law of
+    k z0^(n - m) z^m, m from 1 to n in steps of about `step` (z0 the first guess of the sinkage, so that every law of
     the chain carries the weight at about the same depth), each solution (rounded where
     Newton's method stalls) starting the next."""
     n, k = P.par[L.P_SOIL_N], P.par[L.P_SOIL_K]
@@ -314,8 +312,8 @@ def _solve(P, u, max_iter, tol_rel, failure, check):
         u, norm, it = _continuation(P, u, target, max_iter)
     u, norm, it = _rounded(P, u, norm, it, target, max_iter)
     if not np.isfinite(norm) or norm > 1e-6 * P.weight:
-        if P.par[L.P_SOIL] != 0.0:     # most often a soil too soft for the vehicle: say how soft
-            on = max(int(np.count_nonzero(P.work.sink > 0.0)), 1)
+        on = max(int(np.count_nonzero(P.work.sink > 0.0)), 1)
+        if P.par[L.P_SOIL] != 0.0 and _uniform_sinkage(P, on) > P.par[L.P_PAD_GROUND]:   # a soil too soft
             check = (f"the soil: spread evenly over the {on} pins on it, the weight sinks the track "
                      f"{_uniform_sinkage(P, on):.3g} m (Bekker); a wider track.width or a firmer soil sinks less")
         raise EquilibriumError(f"{failure}: force residual {norm:.3g} N after {it} Newton iterations (needs < "

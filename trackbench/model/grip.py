@@ -1,11 +1,12 @@
 """Bristle friction between the track's pins and rigid ground, compiled: each pin on the
-ground holds a bristle, a tangential spring to an anchor (ModelArrays.touchdown) that
-stays where the pin touched down while the spring carries less than mu p, and is dragged
-along, mu p / k_t behind the pin, while it slides. The anchor moves only after an accepted
-step (remember_grip), so a rejected step leaves no trace; within a step the force is the
-spring's, capped at mu p (contact_force.bristle), a continuous function of the state. A pin
-on two segments at once (the paper's geometry at a concave corner) keeps one anchor, stretched
-along the tangent of the segment met last."""
+ground holds a bristle, a tangential spring with a dashpot to an anchor (ModelArrays.touchdown)
+that stays where the pin touched down while the bristle carries less than mu p, and is dragged
+along while the pin slides (the force then at mu p). The anchor moves only after an accepted
+step (remember_grip), so a rejected step leaves no trace, and it moves so that the force at the
+step's end stays what the step ended with (the next step starts from that derivative); within a
+step the force is the spring's and the dashpot's, capped at mu p (contact_force.bristle), a
+continuous function of the state. A pin on two segments at once (the paper's geometry at a
+concave corner) holds its bristle on the first; the regularised law acts on the other."""
 
 import math
 
@@ -14,9 +15,7 @@ from numba import njit
 from .contact_force import bristle
 from .contact_laws import FRICTION_BRISTLE
 from .jit import BORROW, INLINE
-from .layout import P_BRISTLE_C, P_BRISTLE_K, P_FRICTION, P_FRICTION_LAW, P_SOIL
-
-G_LIMIT, G_TX, G_TY = 0, 1, 2    # columns of Work.grip
+from .layout import G_FORCE, G_LIMIT, G_SPEED, G_TX, G_TY, P_BRISTLE_C, P_BRISTLE_K, P_FRICTION, P_FRICTION_LAW, P_SOIL
 
 
 @njit(**INLINE)
@@ -41,19 +40,22 @@ def pin_grip(b, apos, avel, t, p, par, anchor, grip):
     tx, ty = t
     k = par[P_BRISTLE_K]
     limit = par[P_FRICTION] * p / k
+    v_t = avel[b, 0] * tx + avel[b, 1] * ty
+    f = bristle(limit, k, par[P_BRISTLE_C], bristle_stretch(b, apos, anchor, tx, ty), v_t)
     grip[b, G_LIMIT] = limit
     grip[b, G_TX] = tx
     grip[b, G_TY] = ty
-    v_t = avel[b, 0] * tx + avel[b, 1] * ty
-    f = bristle(limit, k, par[P_BRISTLE_C], bristle_stretch(b, apos, anchor, tx, ty), v_t)
+    grip[b, G_FORCE] = f
+    grip[b, G_SPEED] = v_t
     return f, -f * v_t
 
 
 @njit(**BORROW)
 def remember_grip(m, w):
-    """After an accepted step (the last evaluation was at its end): a pin that touched down
-    anchors its bristle where it is, one whose spring went beyond mu p drags its anchor to
-    mu p / k_t behind it, one that left the ground forgets its anchor."""
+    """After an accepted step (w: the evaluation at its end): a pin that touched down anchors
+    its bristle where it is; one whose force is at mu p (sliding) drags its anchor to where
+    spring and dashpot give that force, -k_t d - c v_t = f, so the force stays f; one that
+    left the ground forgets its anchor."""
     if not uses_bristle(m.par):
         return
     anchor, grip = m.touchdown, w.grip
@@ -66,8 +68,9 @@ def remember_grip(m, w):
             anchor[b, 0] = w.apos[b, 0]
             anchor[b, 1] = w.apos[b, 1]
         else:
-            d = bristle_stretch(b, w.apos, anchor, grip[b, G_TX], grip[b, G_TY])
-            if abs(d) > limit:
-                slide = d - math.copysign(limit, d)
+            k, f = m.par[P_BRISTLE_K], grip[b, G_FORCE]
+            if abs(f) >= k * limit:      # capped (contact_force.bristle returns k limit exactly)
+                d = bristle_stretch(b, w.apos, anchor, grip[b, G_TX], grip[b, G_TY])
+                slide = d - (-f - m.par[P_BRISTLE_C] * grip[b, G_SPEED]) / k
                 anchor[b, 0] += slide * grip[b, G_TX]
                 anchor[b, 1] += slide * grip[b, G_TY]

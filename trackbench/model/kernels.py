@@ -412,6 +412,7 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
             sink[b] = 0.0
         if bristle:
             grip[b, G_LIMIT] = np.nan
+        gripped = False                # the bristle on the pin's first ground contact only
         if nbr[row, NB_COUNT] == 0:    # no ground within reach (the closed track's top run): no call
             continue
         if continuous:
@@ -447,7 +448,8 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
                 force = (p * nx, p * ny, p, e, pd)
-                if bristle:     # the bristle instead of the regularised law
+                if bristle and not gripped:     # the bristle instead of the regularised law
+                    gripped = True
                     ft, fd = pin_grip(b, apos, avel, (ny, -nx), p, par, touchdown, grip)
                     force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
                     dissipation += fd

@@ -281,6 +281,14 @@ P_BRISTLE_K = 39         # tangential stiffness k_t (N/m)
 P_BRISTLE_C = 40         # its dashpot, 2 zeta sqrt(k_t m_pin) (N s/m)
 N_PAR = 41
 
+# --- columns of Work.grip: the bristle friction at the last evaluation (model/grip.py) ---------
+G_LIMIT = 0              # slip limit mu p / k_t (m)
+G_TX = 1                 # the ground's unit tangent
+G_TY = 2
+G_FORCE = 3              # the friction force along it (N)
+G_SPEED = 4              # the pin's speed along it (m/s)
+N_GRIP = 5
+
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point
 ARMS_PY = 1

@@ -17,6 +17,7 @@ from ..model.index import nq_of
 from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
 from ..model.grip import remember_grip
+from ..model.layout import N_GRIP
 from ..model.soil_force import remember_sinkage
 from ..model.rhs import rhs
 from ..status import NAN, SUCCESSFUL
@@ -46,7 +47,7 @@ EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
 
 
 def loop_arrays(stages, ny, n_diag, n_pins):
-    end = EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, 3), np.nan))
+    end = EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, N_GRIP), np.nan))
     return LoopWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
                     np.empty(ny), np.empty(ny), np.empty(n_diag), end)
 
@@ -57,7 +58,7 @@ def _keep_end(w, end):
         end.apos[b, 0] = w.apos[b, 0]
         end.apos[b, 1] = w.apos[b, 1]
         end.sink[b] = w.sink[b]
-        for k in range(3):
+        for k in range(N_GRIP):
             end.grip[b, k] = w.grip[b, k]
 
 
