@@ -422,8 +422,8 @@ def _plot_drawbar_pull(src, ok, out):
         ax.plot(100 * xy[:, 0], xy[:, 1] / 1e3, "o-", color=f"C{k}", ms=4, label=soil.replace("_", " "))
         if np.isfinite(xy[:, 2]).any():
             ax.plot(100 * xy[:, 0], xy[:, 2] / 1e3, "--", color=f"C{k}", lw=1,
-                    label=f"{soil.replace('_', ' ')}: Wong's thrust, uniform pressure")
-    ax.set_xlabel("slip (%)")
+                    label=f"{soil.replace('_', ' ')}: Wong's thrust of the run (uniform pressure, the soil's slip)")
+    ax.set_xlabel("slip at the sprocket (%)")
     ax.set_ylabel("drawbar pull (kN)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
