@@ -18,13 +18,13 @@ from .gaps import (ground_distance, link_frames, pin_cap_weight, pin_ground_sele
                    point_on_segment, segment_coords)
 from .contact_force import friction, normal_force
 from .soil_force import pin_on_soil, soil_shear
-from .grip import G_LIMIT, pin_grip, uses_bristle
+from .grip import pin_grip, uses_bristle
 from .contact_laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .jit import BORROW, INLINE, KERNEL
 from .index import diag_tension
 from .layout import (
     LK_LENGTH, LK_TX, LK_TY,
-    G_REACH, K_GUIDE_LINK, K_GUIDE_PIN, PN_LAST, P_PIN_AREA, P_SOIL,
+    G_LIMIT, G_REACH, K_GUIDE_LINK, K_GUIDE_PIN, PN_LAST, P_PIN_AREA, P_SOIL,
     C_EVALUATIONS, D_DISSIPATION, P_CONTACT_GEOMETRY, P_FRICTION, P_FRICTION_VELOCITY, P_C_GROUND, P_C_WHEEL, P_CONTACT_DAMPING, P_CONTACT_EXPONENT, P_CONTACT_LAW, P_DAMPING_RAMP, P_LINK_DAMPING, P_MIN_APPROACH, P_RESTITUTION_FACTOR, C_REBUILDS, D_CORNER_FORCE, D_E_PAD_GROUND, D_E_PAD_WHEEL, D_E_TENSION, D_GROUND_FX, D_GROUND_FY, D_MAX_TENSION, D_MIN_TENSION, D_OBSTACLE_FORCE, D_POWER, D_STATUS, D_WHEEL, K_CORNER_LINK, K_CORNER_PIN, K_PIN_GROUND, K_WHEEL_LINK, K_WHEEL_PIN, NB_COUNT, P_K_GROUND, P_K_WHEEL, P_LINK_LENGTH, P_LINK_STIFFNESS, P_PAD_GROUND, P_PAD_WHEEL, P_SKIN, P_WHEEL_RADIUS, SEG_LENGTH, SEG_NX, SEG_NY, SEG_TX, SEG_TY, SEG_X0, SEG_Y0,
 )
 

@@ -318,9 +318,9 @@ def _teeth_switch_impl(step, nq, m, ev, best):
             # the teeth's own dashpot (loop.py _teeth), viscous where set
             ramp = m.par[P_DAMPING_RAMP] if m.loop[LP_TOOTH_DAMPING] > 0.0 else -1.0
             shape = tooth_shape(m.loop)
+            q0 = (y0[Q_X], y0[Q_Y], y0[Q_PITCH], y0[i_s])
+            q1 = (y1[Q_X], y1[Q_Y], y1[Q_PITCH], y1[i_s])
             for b in range(1, ev.pins0.shape[0]):
-                q0 = (y0[Q_X], y0[Q_Y], y0[Q_PITCH], y0[i_s])
-                q1 = (y1[Q_X], y1[Q_Y], y1[Q_PITCH], y1[i_s])
                 g0 = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], q0, m.loop, shape)
                 g1 = _teeth_gap(ev.pins1[b, 0], ev.pins1[b, 1], q1, m.loop, shape)
                 best = _switch((K_TEETH, b, 0), g0, g1, True, ramp, step, nq, m, ev, best)
