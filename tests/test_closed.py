@@ -237,6 +237,38 @@ def test_traction_limit(law):
     assert float(abs(ds.energy_residual).max()) < 1e-6
 
 
+def _parked(law):
+    """The closed track held at 0 m/s by the speed drive against a rearward drawbar load of
+    30 kN (about 0.22 mu W), 2 s. Returns (the ground run's pins' x drift over the last
+    second (m), the creep speed the regularised law predicts (m/s), the run)."""
+    sc = tb.Scenario.from_dict({**FLAT, "speed": 0.0, "duration": 2.0, "output_interval": 0.01,
+                                "contact.friction": 0.6, "contact.friction_law": law, "drive.kind": "speed",
+                                "drive.target": 0.0, "drawbar.load": 30e3})
+    ds = tb.simulate(sc)
+    t, px, py = ds.time.values, ds.pin_x.values, ds.pin_y.values
+    half = t >= 1.0
+    ground_run = (py[half] < py[0].min() + 0.02).all(axis=0)   # on the ground all the last second
+    drift = px[-1, ground_run] - px[half][0, ground_run]
+    r = 30e3 / (0.6 * S.equilibrium(sc).weight)
+    return drift, sc["contact.friction_velocity"] * r / math.sqrt(1.0 - r * r), ds
+
+
+def test_parked_load_below_mu_w_sticks_with_bristles_and_creeps_with_the_regularised_law():
+    """Below mu p the regularised law still slides, at the speed where v / sqrt(v^2 + v_eps^2)
+    = F / (mu W) (beyond_paper.md, "Friction"); the bristle law sticks: a pin moves only by
+    its bristle's stretch (below 2 mu p / k_t, ~0.75 mm here)."""
+    creep, predicted, ds = _parked("regularised")
+    stick, _, db = _parked("bristle")
+    for run in (ds, db):
+        assert run.attrs["status"] == "completed"
+        assert float(abs(run.energy_residual).max()) < 1e-6
+    assert len(creep) >= 10 and len(stick) >= 10
+    assert np.all(creep < 0.0)                                            # rearward, every pin
+    assert -np.median(creep) == pytest.approx(predicted * 1.0, rel=0.15)  # over 1 s
+    assert np.median(np.abs(stick)) < 0.1 * predicted * 1.0
+    assert np.abs(stick).max() < 1e-3
+
+
 def test_paper_step_with_the_closed_track():
     """The paper's step at 10 m/s with the closed layout and the speed drive: completes,
     sprocket torque and tensioner force peaks in the summary."""

@@ -255,25 +255,35 @@ def _soil_sinkage(P, pins):
     return _uniform_sinkage(P, max(int(np.sum(pins[:, 1] < pins[:, 1].min() + 0.01)), 1))
 
 
-def _continuation(P, u, target, max_iter, step=0.05):
-    """Newton's method, for a power law F = k delta^n (no stiffness at zero compression,
-    where Newton's method starts) through a chain of laws k d^(n - m) delta^m, m from 1 to
-    n, each solution starting the next: d, a wheel's compression under an equal share of
-    the weight, keeps the forces of every law of the chain alike."""
+def _chain(P, u, target, max_iter, exponent, stiffnesses, d, solve, step=0.05):
+    """Newton's method for a power law F = k x^n (no stiffness at x = 0, where Newton's
+    method starts) through a chain of laws k d^(n - m) x^m, m from 1 to n in steps of about
+    `step`, each solution starting the next: d, a depth the law reaches under the weight,
+    keeps the forces of every law of the chain alike. `exponent` and `stiffnesses` are the
+    P_* indices of n and of the k's that share it; ``solve`` is one link's solver."""
+    par = P.par
+    n, k = par[exponent], [par[i] for i in stiffnesses]
+    it, norm = 0, np.inf
+    for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
+        par[exponent] = m
+        for i, ki in zip(stiffnesses, k):
+            par[i] = ki * d ** (n - m)
+        u, norm, j = solve(P, u, target if m == n else 1e-6 * P.weight, max_iter)
+        it += j
+    par[exponent] = n
+    for i, ki in zip(stiffnesses, k):
+        par[i] = ki                        # exactly the scenario's law again
+    return u, norm, it
+
+
+def _continuation(P, u, target, max_iter):
+    """The contact power law (n != 1) by continuation; d, a wheel's compression under an
+    equal share of the weight."""
     n = P.par[L.P_CONTACT_EXPONENT]
     if n == 1.0:
         return _newton(P, u, target, max_iter)
-    kw, kg = P.par[L.P_K_WHEEL], P.par[L.P_K_GROUND]
-    d = (P.weight / (P.nw * kw)) ** (1.0 / n)
-    it = 0
-    for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
-        P.par[L.P_CONTACT_EXPONENT] = m
-        P.par[L.P_K_WHEEL] = kw * d ** (n - m)
-        P.par[L.P_K_GROUND] = kg * d ** (n - m)
-        u, norm, k = _newton(P, u, target if m == n else 1e-6 * P.weight, max_iter)
-        it += k
-    P.par[L.P_K_WHEEL], P.par[L.P_K_GROUND] = kw, kg   # exactly the scenario's law again
-    return u, norm, it
+    d = (P.weight / (P.nw * P.par[L.P_K_WHEEL])) ** (1.0 / n)
+    return _chain(P, u, target, max_iter, L.P_CONTACT_EXPONENT, (L.P_K_WHEEL, L.P_K_GROUND), d, _newton)
 
 
 def _uniform_sinkage(P, pins_on_soil):
@@ -282,24 +292,16 @@ def _uniform_sinkage(P, pins_on_soil):
     return (p / P.par[L.P_SOIL_K]) ** (1.0 / P.par[L.P_SOIL_N])
 
 
-def _soil_continuation(P, u, target, max_iter, step=0.05):
-    """Soft soil with Bekker's n != 1: Newton's method through a chain of laws
-    k z0^(n - m) z^m, m from 1 to n in steps of about `step` (z0 the first guess of the sinkage, so that every law of
-    the chain carries the weight at about the same depth), each solution (rounded where
-    Newton's method stalls) starting the next."""
-    n, k = P.par[L.P_SOIL_N], P.par[L.P_SOIL_K]
+def _newton_rounded(P, u, target, max_iter):
+    u, norm, it = _newton(P, u, target, max_iter)
+    return _rounded(P, u, norm, it, target, max_iter)
+
+
+def _soil_continuation(P, u, target, max_iter):
+    """Soft soil with Bekker's n != 1 by continuation, each link rounded where Newton's
+    method stalls; d, the sinkage under the weight spread over half the links."""
     z0 = _uniform_sinkage(P, max(int(P.n_links) // 2, 1))
-    it = 0
-    norm = np.inf
-    for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
-        P.par[L.P_SOIL_N] = m
-        P.par[L.P_SOIL_K] = k * z0 ** (n - m)
-        tol = target if m == n else 1e-6 * P.weight
-        u, norm, j = _newton(P, u, tol, max_iter)
-        u, norm, j2 = _rounded(P, u, norm, 0, tol, max_iter)
-        it += j + j2
-    P.par[L.P_SOIL_N], P.par[L.P_SOIL_K] = n, k     # exactly the scenario's law again
-    return u, norm, it
+    return _chain(P, u, target, max_iter, L.P_SOIL_N, (L.P_SOIL_K,), z0, _newton_rounded)
 
 
 def _solve(P, u, max_iter, tol_rel, failure, check):

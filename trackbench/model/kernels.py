@@ -386,6 +386,22 @@ def wheel_contacts(w, m, diag, mem):
 
 
 @njit(**INLINE)
+def _ground_traction(b, apos, avel, t, p, par, soil, gripped):
+    """The tangential force along the ground's unit tangent t on pin b pressed with p:
+    (force, its dissipated power, the mu left for the regularised Coulomb law of _push_pin,
+    gripped). On soft soil Janosi-Hanamoto's shear replaces friction; with the bristle law
+    the pin's first ground contact holds its bristle (later ones, at a concave corner, keep
+    the regularised law); otherwise the regularised law alone."""
+    rut, touchdown, sink, grip = soil
+    if par[P_SOIL] != 0.0:
+        return soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], t, p, par), 0.0, 0.0, gripped
+    if uses_bristle(par) and not gripped:
+        ft, fd = pin_grip(b, apos, avel, t, p, par, touchdown, grip)
+        return ft, fd, 0.0, True
+    return 0.0, 0.0, par[P_FRICTION], gripped
+
+
+@njit(**INLINE)
 def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc):
     """Free pins on ground segments (Fig. 5 left, Eq. 6), the nearest segment only where
     a pin is beyond several (gaps.pin_ground_selection); in the continuous geometry one
@@ -398,13 +414,12 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
     damped = law[1] != DAMPING_NONE
     plain = law[0] == LAW_LINEAR and not damped
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
-    mu = par[P_FRICTION]
     v_eps = par[P_FRICTION_VELOCITY]
     hg = par[P_PAD_GROUND]
     first = rows[K_PIN_GROUND]
     on_soil = par[P_SOIL] != 0.0
     bristle = uses_bristle(par)
-    rut, touchdown, sink, grip = soil
+    rut, _, sink, grip = soil
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, last + 1):
         row = first + b
@@ -436,24 +451,17 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
                     continue
             if s >= hg:
                 continue
-            fr = (mu, v_eps)
-            if on_soil:     # Bekker pressure, Janosi-Hanamoto shear instead of Coulomb friction
+            if on_soil:     # Bekker pressure instead of the pad spring
                 p = pin_on_soil(apos[b, 0], hg - s, par, rut) * par[P_PIN_AREA]
                 e, pd = 0.0, 0.0
                 sink[b] = max(sink[b], hg - s)
-                ft = soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], (ny, -nx), p, par)
-                force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
-                fr = (0.0, v_eps)
             else:
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
-                force = (p * nx, p * ny, p, e, pd)
-                if bristle and not gripped:     # the bristle instead of the regularised law
-                    gripped = True
-                    ft, fd = pin_grip(b, apos, avel, (ny, -nx), p, par, touchdown, grip)
-                    force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
-                    dissipation += fd
-                    fr = (0.0, v_eps)
+            ft, fd, mu_left, gripped = _ground_traction(b, apos, avel, (ny, -nx), p, par, soil, gripped)
+            force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
+            dissipation += fd
+            fr = (mu_left, v_eps)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
             acc = _push_pin(fpin, avel, b, force, (0.0, 0.0), (ny, -nx), fr, acc, (0.0, p if sj > 0 else 0.0))
             gx, gy, corner_force, energy, power, obstacle, dissipation = acc

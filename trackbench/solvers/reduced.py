@@ -14,11 +14,9 @@ from numba import njit
 
 from ..model.jit import BORROW, INLINE, KERNEL
 from ..model.index import nq_of
-from ..model.layout import D_E_GRAVITY, D_STATUS, Q_X, S_E0, Y_WORK
+from ..model.layout import D_E_GRAVITY, D_STATUS, N_GRIP, Q_X, S_E0, Y_WORK
 from ..model.kernels import onset_in_step, remember_onsets
-from ..model.grip import remember_grip
-from ..model.layout import N_GRIP
-from ..model.soil_force import remember_sinkage
+from ..model.memory import has_ground_memory, remember_ground
 from ..model.rhs import rhs
 from ..status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
@@ -121,8 +119,7 @@ def _start(y0, m, w, lw, out):
     init_peaks(out.peaks)
     update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[2 * nq + Y_WORK], e_ref, r_ref, False)
     remember_onsets(m, w)
-    remember_sinkage(m, w)
-    remember_grip(m, w)
+    remember_ground(m, w)
     set_row(out.y, 0, lw.y)
     set_row(out.diag, 0, lw.diag)
     if lw.diag[D_STATUS] != 0.0:
@@ -216,10 +213,12 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
-        _keep_end(w, lw.end)
+        memory = has_ground_memory(m.par)
+        if memory:
+            _keep_end(w, lw.end)
         n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
-        remember_sinkage(m, lw.end)     # the soil's and the bristles' memories: from the accepted end
-        remember_grip(m, lw.end)        # state only, after the samples inside the step
+        if memory:
+            remember_ground(m, lw.end)  # from the accepted end state, after the samples inside the step
         n_rhs += n_new - n_out
         n_out = n_new
         t = t_new
