@@ -13,6 +13,7 @@ from trackbench.model import layout as L
 from trackbench.model.drive import drive_torque
 from trackbench.model.sprocket import pin_on_sprocket
 from trackbench.model.teeth import profile
+from trackbench.quantities import accounted_balance
 from trackbench.scenario import ScenarioError
 
 S = importlib.import_module("trackbench.simulate")
@@ -237,6 +238,20 @@ def test_traction_limit(law):
     assert float(abs(ds.energy_residual).max()) < 1e-6
 
 
+def test_drive_torque_peak_stays_at_its_limit():
+    """The PI drive's integral ramps the torque into drive.torque_limit: the summary's peak is
+    the limit, not a parabola's vertex above the corner (it read 20.000128 kN m here, and up to
+    103 kN m against a 100 kN m limit in the drawbar study)."""
+    from trackbench.output import summary_numbers
+    sc = tb.Scenario.from_dict({**DRIVEN, "terrain": {"kind": "flat"}, "speed": 5.0, "drive.kind": "speed",
+                                "drive.target": 5.5, "drive.gain_p": 1e3, "drive.gain_i": 1e6,
+                                "drive.torque_limit": 2e4, "duration": 0.1, "output_interval": 1e-3})
+    ds = tb.simulate(sc)
+    torque = ds.sprocket_torque.values
+    assert torque[0] < 0.2 * 2e4 and np.mean(torque == 2e4) > 0.3        # ramps up, then held
+    assert summary_numbers(ds)["peak_sprocket_torque_kN m"] == 20.0
+
+
 def _parked(law):
     """The closed track held at 0 m/s by the speed drive against a rearward drawbar load of
     30 kN (about 0.22 mu W), 2 s. Returns (the ground run's pins' x drift over the last
@@ -262,6 +277,9 @@ def test_parked_load_below_mu_w_sticks_with_bristles_and_creeps_with_the_regular
     for run in (ds, db):
         assert run.attrs["status"] == "completed"
         assert float(abs(run.energy_residual).max()) < 1e-6
+        # the paper's balance with the tensioner's spring, the dissipated energy (the drawbar's
+        # work in it) and the drive's work counted: only the integration is left
+        assert np.abs(accounted_balance(run)[0]).max() < 1e-6
     assert len(creep) >= 10 and len(stick) >= 10
     assert np.all(creep < 0.0)                                            # rearward, every pin
     assert -np.median(creep) == pytest.approx(predicted * 1.0, rel=0.15)  # over 1 s

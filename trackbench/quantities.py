@@ -11,6 +11,7 @@ given replicate statistics; an "event" is the time something first happened; a "
 an accuracy figure of the run.
 """
 
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -147,3 +148,37 @@ def values(ds, times=True):
 def without_nan(d):
     """NaN -> None (JSON null) in a dict of numbers."""
     return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
+
+
+def tensioner_energy(ds):
+    """The tensioner spring's potential along the idler's guide, U = -F0 s + k s^2 / 2 (s from
+    the guide's middle, where the spring pushes with its preload F0), or None without an idler.
+    The paper's balance (energy_elastic) leaves it out."""
+    if "idler_position" not in ds:
+        return None
+    idler = json.loads(ds.attrs["scenario"])["idler"]
+    s = ds["idler_position"].values
+    return -idler["preload"] * s + 0.5 * idler["stiffness"] * s * s
+
+
+def accounted_balance(ds):
+    """The paper's balance error with the energy that left or entered on purpose counted:
+    (deviation relative to E0 over time, label). What dampers, friction, soft soil and the
+    drawbar took out (energy_dissipated) is added back, what the drive put in (drive_work)
+    taken out, and the tensioner spring's energy counted with the elastic energy, so the
+    deviation shows only the contact model's jumps and the integration. None where nothing
+    applies (the paper's model: its own balance error is the figure)."""
+    dissipated = ds["energy_dissipated"].values if "energy_dissipated" in ds else None
+    driven = "drive_work" in ds
+    if not driven and (dissipated is None or not (abs(dissipated) > 0.0).any()):
+        return None
+    net = dissipated - dissipated[0]
+    label = "balance + dissipated"
+    spring = tensioner_energy(ds)
+    if spring is not None:
+        net = net + spring - spring[0]
+        label = "balance + tensioner + dissipated"
+    if driven:
+        net = net - (ds["drive_work"].values - ds["drive_work"].values[0])
+        label += " - drive work"
+    return ds["energy_balance_error"].values + net / float(ds.attrs["initial_total_energy"]), label

@@ -459,7 +459,10 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
             ft, fd, mu_left, gripped = _ground_traction(b, apos, avel, (ny, -nx), p, par, soil, gripped)
-            force = (p * nx + ft * ny, p * ny - ft * nx, p, e, pd)
+            fx, fy = p * nx + ft * ny, p * ny - ft * nx
+            if on_soil:     # what the soil takes counts as dissipated (its elastic rebound gives some back)
+                pd = -(fx * avel[b, 0] + fy * avel[b, 1])
+            force = (fx, fy, p, e, pd)
             dissipation += fd
             fr = (mu_left, v_eps)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)

@@ -312,7 +312,7 @@ def loop_rhs(y, m, w, ydot, diag):
         w.genf[k + 1] = acc[k + 1] * par[P_PIN_MASS]
     drive_power = tau * omega
     tensioner_damping = lp[LP_TENSIONER_DAMPING] * sd * sd
-    diag[D_DISSIPATION] += arm_dissipation + tensioner_damping
+    diag[D_DISSIPATION] += arm_dissipation + tensioner_damping - drawbar_power   # the drawbar takes its work out
     ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation + drive_power + tension_force * sd + drawbar_power
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
     ydot[2 * nq + Y_DRIVE_WORK] = drive_power

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..quantities import accounted_balance
 from . import geometry as G
 
 DEFAULT_TIMES = (0.1, 0.35, 0.45)
@@ -256,14 +257,17 @@ def plot_run(ds_or_path, out_dir, times=DEFAULT_TIMES):
           ("energy_gravity", "gravity potential (from t = 0)", "C1"), ("energy_balance", "balance (sum)", "k"))]
     deviation = [(100 * ds["energy_balance_error"].values, "energy balance", {"color": "k", "lw": 0.9}),
                  (100 * ds["energy_residual"].values, "work-based residual", {"color": "C3", "lw": 0.9})]
-    if "energy_dissipated" in ds and float(ds["energy_dissipated"][-1]) > 0.0:
-        # with dampers the paper's balance falls by what they dissipated: balance + dissipated stays
+    accounted = accounted_balance(ds)
+    if accounted is not None:
+        # energy that left on purpose (dampers, friction, soil, drawbar) added back, the drive's taken out
+        closed, label = accounted
         dissipated = ds["energy_dissipated"].values
+        e.append((dissipated / 1e3, "dissipated (dampers, friction, soil, drawbar)", {"color": "C5", "lw": 1.0}))
+        if "drive_work" in ds:
+            e.append((ds["drive_work"].values / 1e3, "drive work", {"color": "C6", "lw": 1.0}))
         e0 = float(ds.attrs["initial_total_energy"])
-        e.append(((ds["energy_balance"].values + dissipated) / 1e3, "balance + dissipated", {"color": "C4", "lw": 1.0}))
-        e.append((dissipated / 1e3, "dissipated (dampers, friction)", {"color": "C5", "lw": 1.0}))
-        deviation.append((100 * (ds["energy_balance_error"].values + (dissipated - dissipated[0]) / e0),
-                          "balance + dissipated", {"color": "C4", "lw": 0.9}))
+        e.append(((ds["energy_balance"].values[0] + e0 * (closed - closed[0])) / 1e3, label, {"color": "C4", "lw": 1.0}))
+        deviation.append((100 * closed, label, {"color": "C4", "lw": 0.9}))
     paths.append(_time_plot(out / "energy.png", f"{name}: energies (cf. Fig. 18)",
                             [("energy (kJ)", e), ("balance deviation (% of E0)", deviation)], ds))
     return paths

@@ -79,12 +79,14 @@ def _up(peaks, k, v, t, t_switch):
     smooth peak is found to O(h^3) rather than to the step spacing (O(h^2)). Not when the
     previous step ended at a located contact switch (t_switch): there the quantity has a
     kink, its extreme is the sample itself, and a parabola would overshoot it; nor across
-    steps more unequal than STEP_RATIO."""
+    steps more unequal than STEP_RATIO; nor at a flat top (a sample equal to its neighbour:
+    a quantity held at a limit, the drive's torque at drive.torque_limit), where a parabola
+    through the corner into the limit rises above it."""
     if v > peaks[k, 0]:
         peaks[k, 0] = v
         peaks[k, 1] = t
     f0, t0, f1, t1 = peaks[k, 2], peaks[k, 3], peaks[k, 4], peaks[k, 5]
-    if (f1 >= f0 and f1 >= v and t1 != t_switch and t0 < t1 < t
+    if (f1 > f0 and f1 > v and t1 != t_switch and t0 < t1 < t
             and (t - t1) <= STEP_RATIO * (t1 - t0) <= STEP_RATIO ** 2 * (t - t1)):
         d01 = (f1 - f0) / (t1 - t0)
         d12 = (v - f1) / (t - t1)
