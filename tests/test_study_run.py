@@ -224,7 +224,7 @@ def test_replicates_run_with_distinct_perturbed_starts(tmp_path):
     assert 0 < np.abs(y[0] - y[1]).max() < 1e-8   # the 1e-9 m nudge, seeded differently
 
 
-def test_open_study_dataset_aligns_different_durations(tmp_path):
+def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
     p = tmp_path / "a.toml"
     p.write_text("[study]\nname = 'a'\n[scenario]\noutput_interval = 0.001\nrecord = { enabled = false }\n"
                  "[[runs]]\nduration = 0.03\n[[runs]]\nduration = 0.05\n")
@@ -234,6 +234,11 @@ def test_open_study_dataset_aligns_different_durations(tmp_path):
     cy = ds.chassis_y.load()
     assert np.isnan(cy[0, -5:]).all() and not np.isnan(cy[1]).any() and not np.isnan(cy[0, :31]).any()
     assert list(ds.duration.values) == [0.03, 0.05]
+    # without dask (the README's plain install) the same dataset, read into memory
+    from trackbench.study import summary
+    monkeypatch.setattr(summary, "_have_dask", lambda: False)
+    eager = tb.open_study_dataset(tmp_path / "a")
+    assert eager.chunks == {} and eager.identical(ds.load())
     ds.close()
     # the folder is read from its runs.json, not by expanding study.toml again (defaults may change)
     (tmp_path / "a" / "study.toml").write_text("[scenario]\nduration = 0.07\n")

@@ -1,5 +1,6 @@
 """Reading a study: the pandas summary, replicate statistics, open_study / open_study_dataset."""
 
+import importlib.util
 from pathlib import Path
 
 import numpy as np
@@ -151,10 +152,27 @@ def open_study(path, run=None):
     return summary_frame(_study_of(path))
 
 
+_STACK = dict(join="outer", data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts")
+
+
+def _have_dask():
+    return importlib.util.find_spec("dask") is not None
+
+
+def _stacked(paths, lazy):
+    """The runs' files along ``run``: lazily with dask (xarray.open_mfdataset) where it is
+    installed (the `dask` extra), else read into memory (each file closed after reading)."""
+    import xarray as xr
+    if lazy:
+        return xr.open_mfdataset(paths, combine="nested", concat_dim="run", parallel=False, **_STACK)
+    return xr.concat([xr.load_dataset(p) for p in paths], dim="run", **_STACK)
+
+
 def open_study_dataset(path, status=("completed", "failed")):
     """All runs' time histories stacked along a ``run`` dimension, opened lazily (dask) with
-    xarray.open_mfdataset; runs of different durations are aligned on time (NaN-padded).
-    The study's parameters and each run's status become coordinates along ``run``."""
+    xarray.open_mfdataset where dask is installed, else read into memory; runs of different
+    durations are aligned on time (NaN-padded). The study's parameters and each run's status
+    become coordinates along ``run``."""
     import xarray as xr
     study = _study_of(path)
     df = summary_frame(study)
@@ -164,9 +182,7 @@ def open_study_dataset(path, status=("completed", "failed")):
     df, paths = df[keep], [p for p, k in zip(paths, keep) if k]
     if not paths:
         raise FileNotFoundError(f"no run of study {study.name} has a timeseries.nc yet")
-    ds = xr.open_mfdataset(paths, combine="nested", concat_dim="run", join="outer", data_vars="all",
-                           coords="minimal", compat="override", combine_attrs="drop_conflicts",
-                           parallel=False)
+    ds = _stacked(paths, lazy=_have_dask())
     coords = {"run": ("run", df.run_id.to_numpy()), "status": ("run", df.status.to_numpy())}
     for p in study.param_names:
         coords[p] = ("run", df[p].to_numpy())
