@@ -7,14 +7,14 @@ from trackbench import output, quantities
 from trackbench.replay.plots import study_axes
 from trackbench.study.executors import run_summary
 
-SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1"}
+SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1"}
 
 
 def test_the_table_matches_the_dataset(paper_run_short):
     """Every quantity is a Dataset variable whose SI unit its display unit converts from;
     each peak has its _time."""
-    _check_table(paper_run_short, [q for q in quantities.TABLE if not q.closed])
-    assert not any(q.variable in paper_run_short for q in quantities.TABLE if q.closed)
+    _check_table(paper_run_short, [q for q in quantities.TABLE if not q.needs])
+    assert not any(q.variable in paper_run_short for q in quantities.TABLE if q.needs)
 
 
 def _check_table(ds, table):
@@ -22,7 +22,7 @@ def _check_table(ds, table):
         var = ds[q.variable]
         assert var.attrs["units"] == SI_OF[q.unit], q.variable
         assert var.dims == (("wheel",) if q.per_wheel else ()), q.variable
-        assert q.kind in ("peak", "event", "check")
+        assert q.kind in ("peak", "mean", "event", "check")
         if q.kind == "peak":
             assert ds[q.variable + "_time"].attrs["units"] == "s"
 
@@ -30,11 +30,28 @@ def _check_table(ds, table):
 def test_the_closed_track_quantities_match_its_dataset():
     import trackbench as tb
     ds = tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "duration": 2e-3, "speed": 0.0}))
-    _check_table(ds, quantities.TABLE)
+    _check_table(ds, [q for q in quantities.TABLE if q.needs != "soil"])
     cols = [c for q, c, _, _ in quantities.entries(ds)]
     assert "peak_sprocket_torque" in cols and "peak_idler_force" in cols
-    assert "peak_sprocket_torque" in quantities.summary_columns(5, closed=True)
+    assert "peak_sprocket_torque" in quantities.summary_columns(5, features={"closed"})
     assert "peak_sprocket_torque" not in quantities.summary_columns(5)
+
+
+def test_the_soil_quantities_match_their_dataset():
+    """Deepest sinkage (the soil's memory: every accepted step), drawbar pull and slip means
+    over the run's second half, in the summary of a driven closed track on soil."""
+    import numpy as np
+    import trackbench as tb
+    ds = tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "terrain": {"kind": "flat", "soil": "lete_sand"},
+                                            "drive.kind": "speed", "speed": 4.0, "duration": 0.05}))
+    _check_table(ds, quantities.TABLE)
+    v = quantities.values(ds)
+    assert v["peak_sinkage"] >= float(ds.sinkage.max()) > 0.0
+    late = ds.time.values >= 0.025
+    assert v["mean_drawbar_pull"] == float(ds.drawbar_pull[late].mean())
+    assert v["mean_slip"] == float(np.nanmean(ds.slip.values[late]))
+    assert "mean_slip" in quantities.peak_columns(5, features={"soil"})
+    assert "peak_sinkage" not in quantities.summary_columns(5, features={"closed"})
 
 
 def test_summary_columns_in_the_documented_order():

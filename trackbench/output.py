@@ -208,13 +208,26 @@ def _soil(model, result, ground, placed):
     plastic = np.maximum(rut - par[L.P_SOIL_K] * rut ** par[L.P_SOIL_N] / par[L.P_SOIL_KE], 0.0)
     used = np.flatnonzero(rut > 0.0)
     lo, hi = (used[0], used[-1] + 1) if used.size else (0, 0)
-    v = {"drawbar_pull": _var(T, d[:, L.D_GROUND_FX], "N", "net horizontal force of the ground (soil shear and "
-                              "pressure) on the track: thrust minus the soil's resistance")}
+    pull = d[:, L.D_GROUND_FX]
+    late = result.time >= 0.5 * result.time[-1]     # the run's second half (quantities.py, "mean")
+    deepest = np.unravel_index(np.argmax(sink), sink.shape)[0]
+    v = {"drawbar_pull": _var(T, pull, "N", "net horizontal force of the ground (soil shear and "
+                              "pressure) on the track: thrust minus the soil's resistance"),
+         # the memory keeps the deepest sinkage of every accepted step; its time: the deepest sample's
+         "peak_sinkage": _var((), float(rut.max(initial=0.0)), "m", "deepest sinkage into the soil over all "
+                              "accepted steps"),
+         "peak_sinkage_time": _var((), float(result.time[deepest]), "s", "time of the deepest sinkage among the "
+                                   "output samples"),
+         "mean_drawbar_pull": _var((), float(pull[late].mean()), "N", "drawbar_pull, mean over the run's "
+                                   "second half")}
     if model.closed:
         track = -qd[:, L.q_sprocket(model.nw, model.n_links)] * model.arrays.loop[L.LP_PITCH_RADIUS]
         with np.errstate(divide="ignore", invalid="ignore"):
             slip = np.where(np.abs(track) > 1e-3, 1.0 - qd[:, L.Q_X] / track, np.nan)
         v["slip"] = _var(T, slip, "1", "slip: 1 - chassis speed / (sprocket speed x pitch radius)")
+        with np.errstate(invalid="ignore"):
+            v["mean_slip"] = _var((), float(np.nanmean(slip[late])) if np.isfinite(slip[late]).any() else np.nan,
+                                  "1", "slip, mean over the run's second half")
     return {**v, "sinkage": _var(P, sink, "m", "pin's sinkage below the soil surface (0 off the soil)"),
             "rut_depth": _var(("rut_x",), plastic[lo:hi], "m", "plastic sinkage the soil keeps at the end of "
                               "the run (the rut), along x"),

@@ -7,8 +7,11 @@ statistics, the study table on screen, the study plots and the solver text of a 
 The Dataset variables themselves are built by output.py (SI units, with long_names).
 
 Kinds: a "peak" is an extremum of the motion, stored with its time (``<column>_time``) and
-given replicate statistics; an "event" is the time something first happened; a "check" is
-an accuracy figure of the run.
+given replicate statistics; a "mean" is a mean over the run's second half (t >= t_final / 2:
+a steady value where the run settles), also given replicate statistics; an "event" is the
+time something first happened; a "check" is an accuracy figure of the run. A quantity that
+``needs`` a feature ("closed": the closed track; "soil": soft soil) is in a run's summary only
+when the run has it, and in a study's when any of its runs has it.
 """
 
 import json
@@ -29,7 +32,7 @@ class Quantity:
     late: bool           # decided after the motion turns chaotic (first link compression):
     #                      differs by 10-60 % between correct runs, compare as a range
     summary: bool = True  # in the summary (run.json, summary.csv, one-screen summary)
-    closed: bool = False  # the closed track's only (track.layout = "closed")
+    needs: str = ""       # "closed" / "soil": that model's only (module docstring)
 
     @property
     def per_wheel(self):
@@ -73,9 +76,15 @@ TABLE = (
       late=True),
     Q("min_chassis_vx", "min_chassis_vx", "peak", "m/s", 1.0, "min chassis speed", "vx min", late=True),
     Q("peak_sprocket_torque", "peak_sprocket_torque", "peak", "kN m", 1e3, "peak drive torque on the sprocket",
-      "sprk kNm", late=True, closed=True),
+      "sprk kNm", late=True, needs="closed"),
     Q("peak_idler_force", "peak_idler_force", "peak", "kN", 1e3, "peak tensioner force", "idler kN", late=True,
-      closed=True),
+      needs="closed"),
+    Q("peak_sinkage", "peak_sinkage", "peak", "cm", 1e-2, "deepest sinkage into the soil", "sink cm", late=True,
+      needs="soil"),
+    Q("mean_drawbar_pull", "mean_drawbar_pull", "mean", "kN", 1e3, "mean drawbar pull, 2nd half",
+      "pull kN", late=True, needs="soil"),
+    Q("mean_slip", "mean_slip", "mean", "%", 1e-2, "mean slip (sprocket), 2nd half", "slip %",
+      late=True, needs="soil"),
     Q("first_contact_time", "first_contact_time", "event", "s", 1.0, "first obstacle contact", None, late=False),
     Q("first_compression_time", "first_compression_time", "event", "s", 1.0, "first link compression", "compr s",
       late=False),
@@ -87,24 +96,24 @@ TABLE = (
 del Q
 BY_NAME = {q.variable: q for q in TABLE}
 SUMMARY = tuple(q for q in TABLE if q.summary)
-PEAKS = tuple(q for q in SUMMARY if q.kind == "peak")
+PEAKS = tuple(q for q in SUMMARY if q.kind in ("peak", "mean"))
 
 
-def summary_columns(n_wheels, times=True, closed=False):
+def summary_columns(n_wheels, times=True, features=()):
     """The summary's result columns in order: each peak with its _time, then the rest
-    (the closed track's own where closed)."""
+    (those of the models in ``features``, "closed" and "soil", where given)."""
     out = []
     for q in SUMMARY:
-        if q.closed and not closed:
+        if q.needs and q.needs not in features:
             continue
         for c in q.columns(n_wheels):
             out += [c, c + "_time"] if times and q.kind == "peak" else [c]
     return out
 
 
-def peak_columns(n_wheels, closed=False):
-    """The peaks' columns (those with replicate statistics)."""
-    return [c for q in PEAKS if closed or not q.closed for c in q.columns(n_wheels)]
+def peak_columns(n_wheels, features=()):
+    """The peaks' and means' columns (those with replicate statistics)."""
+    return [c for q in PEAKS if not q.needs or q.needs in features for c in q.columns(n_wheels)]
 
 
 def quantity_of(column):
@@ -123,7 +132,7 @@ def entries(ds):
     """(quantity, column, SI value, time or None) of a run's Dataset, in table order; plain
     floats, NaN kept (a run without a link compression has no first_compression_time)."""
     for q in SUMMARY:
-        if q.closed and q.variable not in ds:
+        if q.needs and q.variable not in ds:
             continue
         v = ds[q.variable]
         t = ds[q.variable + "_time"] if q.kind == "peak" else None

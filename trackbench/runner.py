@@ -49,7 +49,7 @@ def _energy_line(ds, s):
 
 def format_summary(ds, path=None):
     from .output import summary_numbers
-    from .quantities import BY_NAME as q
+    from .quantities import BY_NAME as q, SUMMARY
     s, a = summary_numbers(ds), ds.attrs
     lines = [f"trackbench run '{a['title'].split(': ', 1)[-1]}': {a['status']}"
              + ("" if a["status"] == "completed" else f" at t = {a['t_final']:.6g} s: {a['status_message']}")]
@@ -74,6 +74,10 @@ def format_summary(ds, path=None):
         line(vx.label, f"{shown(vx.name):.4f} {vx.unit}"),
         line(contact.label, f"{_time(shown(contact.name), 5)}; {compression.label} "
                             f"{_time(shown(compression.name), 4)}"),
+    ]
+    # the closed track's and the soil's own (sprocket torque, tensioner force, sinkage, pull, slip)
+    lines += [line(x.label, f"{shown(x.name):10.2f} {x.unit}") for x in SUMMARY if x.needs and x.variable in ds]
+    lines += [
         _energy_line(ds, s),
         f"  steps {a['steps']} (+{a['rejected_steps']} rejected), wall time {a['wall_time']:.3f} s",
     ]

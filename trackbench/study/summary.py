@@ -21,18 +21,25 @@ def _wheels(study):
     return max(n)
 
 
-def _closed(study):
-    return any(r.scenario["track"].get("layout") == "closed" for r in study.runs)
+def _features(study):
+    """The models some run of the study has: "closed" (track), "soil" (soft soil)."""
+    out = set()
+    for r in study.runs:
+        if r.scenario["track"].get("layout") == "closed":
+            out.add("closed")
+        if r.scenario["terrain"].get("soil", "rigid") != "rigid":
+            out.add("soil")
+    return out
 
 
 def peak_columns(study):
-    """The summary's peak columns, in summary order (replicate statistics cover these)."""
-    return Q.peak_columns(_wheels(study), _closed(study))
+    """The summary's peak and mean columns, in summary order (replicate statistics cover these)."""
+    return Q.peak_columns(_wheels(study), _features(study))
 
 
 def summary_frame(study):
     """One row per run of the study (pending when it has not run), from the runs' run.json."""
-    results = Q.summary_columns(_wheels(study), closed=_closed(study))
+    results = Q.summary_columns(_wheels(study), features=_features(study))
     rows = []
     for run in study.runs:
         rec = store.read_run(study.output, run.run_id) or {"status": "pending", "status_message": ""}
