@@ -27,3 +27,31 @@ def test_position_in_a_study_scenario_table(tmp_path):
 def test_two_placements_in_one_table_are_still_an_error():
     with pytest.raises(ScenarioError, match="only one of"):
         tb.Scenario.paper(terrain={"kind": "step", "height": 0.1, "position": 2.0, "first_contact_time": 0.05})
+
+
+@pytest.mark.parametrize("terrain, front", [
+    ({"kind": "step", "height": 0.1, "position": 0.5}, 1.607),      # its top corner inside the track
+    ({"kind": "bump", "height": 0.1, "length": 0.5, "position": 1.0}, 1.43),   # its foot under the ground run
+])
+def test_an_obstacle_under_the_resting_track_is_refused_before_the_run(terrain, front):
+    """Placed by position behind where the resting track's ground side reaches its first
+    corner's height, an obstacle would stand in the track at t = 0 (the run failed after
+    5 ms with "a ground corner went through the track")."""
+    with pytest.raises(ScenarioError, match=rf"terrain.position = .* under the resting track .*x = {front}"):
+        tb.simulate(tb.Scenario.paper(terrain=terrain, duration=0.01))
+
+
+def test_an_obstacle_just_ahead_of_the_track_is_accepted():
+    ds = tb.simulate(tb.Scenario.paper(terrain={"kind": "step", "height": 0.1, "position": 1.65}, duration=0.01))
+    assert ds.attrs["status"] == "completed"
+
+
+def test_placement_by_time_needs_a_speed():
+    with pytest.raises(ScenarioError, match=r"first_contact_time = 0.0568 s needs speed > 0"):
+        tb.Scenario.paper(speed=0.0)
+    assert tb.Scenario.paper(speed=0.0, terrain={"kind": "flat"})["speed"] == 0.0
+
+
+def test_one_road_wheel_is_not_a_vehicle():
+    with pytest.raises(ScenarioError, match=r"vehicle.n_wheels = 1 is not allowed: expected an integer in \[2, 20\]"):
+        tb.Scenario.paper(**{"vehicle.n_wheels": 1})

@@ -80,7 +80,7 @@ RULES = {
     "vehicle.arm_angle": (float, 0.0, 90.0, "a number in (0, 90) deg"),
     "vehicle.torsion_stiffness": _POS,
     "vehicle.wheel_radius": _POS,
-    "vehicle.n_wheels": (int, 1, 20, "an integer in [1, 20]"),
+    "vehicle.n_wheels": (int, 2, 20, "an integer in [2, 20]"),
     "vehicle.first_pivot_x": (float, -math.inf, math.inf, "a finite number (m)"),
     "vehicle.pivot_y": (float, -math.inf, math.inf, "a finite number (m)"),
     "vehicle.pivot_spacing": _POS,
@@ -549,6 +549,17 @@ def _check_extensions(d, explicit):
                                 "use solver = 'reduced' for the models beyond the paper")
 
 
+def _check_placed_by_time(out):
+    """An obstacle placed by first_contact_time stands speed x time ahead of the resting track:
+    at speed 0 it would stand against the track at t = 0, whatever time was asked."""
+    t = out["terrain"]
+    first = t["obstacles"][0] if t["kind"] == "sequence" else t
+    if out["speed"] == 0.0 and first.get("first_contact_time", 0.0) > 0.0:
+        raise ScenarioError(f"terrain.first_contact_time = {first['first_contact_time']} s needs speed > 0 (the "
+                            "obstacle is placed speed x time ahead of the track); at speed 0 give terrain.position "
+                            "(m) or a flat terrain")
+
+
 def validate(d, explicit=frozenset()):
     out = copy.deepcopy(d)
     flat = flatten({k: v for k, v in d.items() if k != "terrain"})
@@ -563,6 +574,7 @@ def validate(d, explicit=frozenset()):
     if out["duration"] / out["output_interval"] > 2_000_000:
         raise ScenarioError("output_interval is too small for this duration: at most 2,000,000 output samples")
     _check_geometry(out["vehicle"], out["track"])
+    _check_placed_by_time(out)
     out["vehicle"]["arm_damping"] = [float(a) for a in out["vehicle"]["arm_damping"]]
     _check_extensions(out, explicit)
     _check_closed(out, explicit)

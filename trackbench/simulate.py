@@ -15,7 +15,7 @@ from .model import layout as L
 from .model.bundles import arm_table, model_arrays, work_arrays
 from .model.parameters import arm_damping, pack, total_mass
 from .model.terrain import build_ground  # noqa: F401  (part of this module's API)
-from .scenario import Scenario
+from .scenario import Scenario, ScenarioError
 
 
 @functools.lru_cache(maxsize=32)
@@ -185,7 +185,10 @@ def simulate(scenario: Scenario, progress=None):
         scenario = Scenario.from_dict(scenario)
     t_wall = time.perf_counter()
     eq = equilibrium(scenario)
-    ground, resolved = build_ground(scenario, eq)
+    try:
+        ground, resolved = build_ground(scenario, eq)
+    except ValueError as e:   # an obstacle placed where it cannot stand: before the run, one line
+        raise ScenarioError(str(e)) from None
     model = Model(scenario, eq, ground)
     y0 = initial_state(scenario, eq)
     if scenario["solver"] == "lee":

@@ -81,6 +81,21 @@ def contact_x(eq, height, pad_ground):
     return float(best)
 
 
+def _check_ahead(x, ob, eq, pad_ground):
+    """The first obstacle must start ahead of the resting track: where its first corner's
+    height (a step's or a block's top, a ramp's or a bump's foot) meets the track's ground-side
+    surface. Behind that, it stands in the track at t = 0."""
+    h = ob["height"] if ob["kind"] in ("step", "block") else 0.0
+    try:
+        front = contact_x(eq, h, pad_ground)
+    except ValueError:       # taller than the track's front: its foremost point
+        front = float(eq.info["pins"][:, 0].max()) + pad_ground
+    if x < front:
+        raise ValueError(f"terrain.position = {x:.4g} m puts the {ob['kind']} under the resting track (its ground "
+                         f"side reaches x = {front:.4g} m at height {h:g} m): place it further ahead, or by "
+                         "first_contact_time")
+
+
 def build_ground(scenario, eq):
     """Terrain polyline of the scenario, with obstacles placed by time resolved."""
     t = scenario["terrain"]
@@ -101,6 +116,8 @@ def build_ground(scenario, eq):
             x = x_end + ob["gap"]
         else:
             x = ob["position"]
+        if i == 0 and "first_contact_time" not in ob:
+            _check_ahead(x, ob, eq, scenario["track.pad_ground"])
         if x < x_end:
             raise ValueError(f"terrain obstacle {i} starts at x = {x:.4g} m, before the previous one ends "
                              f"({x_end:.4g} m)")
