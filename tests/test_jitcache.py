@@ -33,3 +33,32 @@ def test_prune_keeps_old_folders_within_keep(tmp_path):
     old = [_folder(tmp_path, f"o{i}", (2 + i) * _jitcache.IDLE) for i in range(_jitcache.KEEP - 1)]
     _jitcache._prune(tmp_path, current)
     assert all(p.exists() for p in old)
+
+
+def test_compile_notice_says_once_when_numba_compiles(capsys):
+    """`trackbench run` says when it compiles (a first run of a kind takes about a minute with
+    nothing else on screen) and how long; loading from the cache says nothing."""
+    import io
+
+    from numba import njit
+
+    from trackbench._jitcache import CompileNotice
+
+    @njit
+    def inner(x):
+        return x + 1.0
+
+    @njit
+    def outer(x):
+        return inner(x) * 2.0
+
+    out = io.StringIO()
+    with CompileNotice(out) as notice:
+        assert outer(1.0) == 4.0          # compiles outer, and inner inside it
+        assert outer(2.0) == 6.0          # compiled: no event
+    assert out.getvalue().count("compiling the model") == 1
+    assert notice.seconds > 0.0
+    quiet = io.StringIO()
+    with CompileNotice(quiet) as again:
+        outer(3.0)
+    assert quiet.getvalue() == "" and again.seconds == 0.0

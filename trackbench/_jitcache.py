@@ -61,3 +61,42 @@ def _prune(base, target):
     for t, p in sorted(folders, reverse=True)[KEEP - 1:]:
         if now - t > IDLE:
             shutil.rmtree(p, ignore_errors=True)
+
+
+class CompileNotice:
+    """While active, says once (on ``stream``) when numba starts compiling a kernel instead of
+    loading it from the cache: the first run of a kind (paper, closed track, soil, lee) on a
+    machine, or after an upgrade, compiles for about a minute with nothing else to show.
+    ``seconds`` is the time spent compiling (nested compilations counted once)."""
+
+    def __init__(self, stream):
+        self.stream, self.seconds, self._depth, self._t0 = stream, 0.0, 0, 0.0
+
+    def __enter__(self):
+        from numba.core import event
+
+        notice = self
+
+        class _Listener(event.Listener):
+            def on_start(self, ev):
+                if notice._depth == 0:
+                    if notice.seconds == 0.0:
+                        print("compiling the model for this kind of run (first use on this machine or after an "
+                              "upgrade: about a minute; later runs load it from the cache) ...",
+                              file=notice.stream, flush=True)
+                    notice._t0 = time.perf_counter()
+                notice._depth += 1
+
+            def on_end(self, ev):
+                notice._depth -= 1
+                if notice._depth == 0:
+                    notice.seconds += max(time.perf_counter() - notice._t0, 1e-9)
+
+        self._listener = _Listener()
+        event.register("numba:compile", self._listener)
+        return self
+
+    def __exit__(self, *exc):
+        from numba.core import event
+        event.unregister("numba:compile", self._listener)
+        return False

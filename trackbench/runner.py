@@ -1,5 +1,6 @@
 """`trackbench run`: one scenario from the command line, its file and its summary."""
 
+import sys
 import tomllib
 from pathlib import Path
 
@@ -102,12 +103,14 @@ def run_one(sets, duration, out, name, force=False, storage="full"):
     sc = sc.with_overrides({"name": name})
     from .output import write_netcdf
     from .replay.record import maybe_write_recording
+    from ._jitcache import CompileNotice
     from .simulate import simulate
     targets = [Path(out) / f"{name}{ext}" for ext in (".nc", ".rrd", ".failed.nc")]
     existing = [p for p in targets if p.exists()]
     if existing and not force:
         raise ScenarioError(f"{existing[0]} exists: choose another --name or --out, or --force to replace it")
-    ds = simulate(sc)
+    with CompileNotice(sys.stderr) as compiled:
+        ds = simulate(sc)
     ok = ds.attrs["status"] == "completed"
     path = write_netcdf(ds, targets[0] if ok else targets[2], storage)
     for stale in existing:
@@ -115,7 +118,10 @@ def run_one(sets, duration, out, name, force=False, storage="full"):
             stale.unlink(missing_ok=True)
     if ok:
         maybe_write_recording(ds, Path(out), name=f"{name}.rrd", storage=storage)
-    return format_summary(ds, path), ok
+    text = format_summary(ds, path)
+    if compiled.seconds > 0.0:
+        text += f"\n  of the wall time, {compiled.seconds:.1f} s compiling (once: later runs load the model from the cache)"
+    return text, ok
 
 
 def parameter_table():
