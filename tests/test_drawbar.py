@@ -140,3 +140,17 @@ def test_study_plot_draws_drawbar_pull_against_slip(tmp_path):
     paths = plot_study(tmp_path, tmp_path / "plots")
     assert tmp_path / "plots" / "study_drawbar_pull.png" in paths
     assert (tmp_path / "plots" / "study_drawbar_pull.png").stat().st_size > 10_000
+
+
+def test_study_plot_leaves_out_drawbar_pull_without_a_drawbar(tmp_path):
+    """A soft-soil study of free-running speeds (no drawbar axis, none set): no pull-against-slip figure."""
+    pytest.importorskip("matplotlib")
+    import pandas as pd
+    from trackbench.replay.plots import plot_study
+    rows = []
+    for k, (speed, slip, pull) in enumerate(((3.0, 0.02, -100.0), (6.0, 0.04, 2.6e3))):
+        _fake_soil_run(tmp_path / "runs" / f"r{k}" / "timeseries.nc", slip, pull)
+        rows.append({"run_id": f"r{k}", "status": "completed", "speed": speed, "peak_wheel1_force_y": 1e5})
+    pd.DataFrame(rows).to_csv(tmp_path / "summary.csv", index=False)
+    paths = plot_study(tmp_path, tmp_path / "plots")
+    assert [p.name for p in paths] == ["study_speed.png"]

@@ -183,8 +183,71 @@ def test_run_plots_are_real_images(step_run, tmp_path):
     tan = np.all(np.abs(conf - np.array([0xd8, 0xc3, 0xa0]) / 255) < 0.03, axis=-1).mean()
     green = np.all(np.abs(conf - G.TENSION_RGB[2] / 255) < 0.06, axis=-1).mean()
     assert tan > 0.02 and green > 0.001
-    with pytest.raises(ValueError, match="none of the times"):
-        plot_run(step_run, tmp_path / "x", times=(0.3,))
+    # a time after the run's end: left out, times spread over the run instead (no error)
+    late = plot_run(step_run, tmp_path / "x", times=(0.3,))
+    assert late[0].name == "configuration.png" and mpimg.imread(late[0]).shape[0] > 1300   # three panels
+
+
+def fake_times(t_end, status="completed", n=200):
+    return xr.Dataset(coords={"time": np.linspace(0.0, t_end, n)}, attrs={"status": status})
+
+
+def test_default_configuration_times_lie_in_the_run():
+    from trackbench.replay.plots import PAPER_TIMES, choose_times, default_times
+    assert default_times(fake_times(0.5)) == PAPER_TIMES                   # the paper's run: its times
+    assert default_times(fake_times(1.5)) == pytest.approx((0.5, 1.0, 1.5))  # spread over a long run
+    short = default_times(fake_times(0.2))
+    assert len(short) == 3 and max(short) == pytest.approx(0.2)
+    failed = default_times(fake_times(0.05, "failed"))                   # up to where it stopped
+    assert len(failed) == 3 and failed[-1] == pytest.approx(0.05) and min(failed) > 0.0
+    # a failed run of the paper's length still shows its last sample
+    assert default_times(fake_times(0.48, "failed"))[-1] == pytest.approx(0.48)
+    chosen, note = choose_times(fake_times(0.2), (0.1, 0.35, 0.45))
+    assert chosen == [0.1] and "0.35, 0.45 s left out" in note
+    chosen, note = choose_times(fake_times(0.05, "failed"), (0.1,))
+    assert chosen[-1] == pytest.approx(0.05) and "spread" in note
+
+
+def test_failed_short_run_still_gets_its_figures(step_run, tmp_path):
+    import matplotlib.image as mpimg
+    ds = step_run.isel(time=step_run["time"].values <= 0.04)
+    ds.attrs = {**step_run.attrs, "status": "failed", "t_final": 0.04}
+    paths = plot_run(ds, tmp_path, times=(0.1, 0.35, 0.45))   # what `trackbench plot` passes by default
+    assert [p.name for p in paths][:2] == ["configuration.png", "wheel_force.png"]
+    assert mpimg.imread(paths[0]).shape[0] > 1300                  # three panels up to 0.04 s
+
+
+def test_configuration_frames_the_vehicle_and_scales_the_arrows(step_run):
+    import matplotlib.pyplot as plt
+    from trackbench.replay.plots import _arrow_scale, draw_configuration
+    i = int(np.argmax(step_run["wheel_force_y"].values.max(axis=1)))   # the hardest hit on the step
+    g = G.side_view(step_run, [i])
+    top = float(g["chassis"][0][:, 1].max()) + 0.15
+    assert float((g["wheel_arrow_origin"][0] + g["wheel_arrow_vector"][0])[:, 1].max()) > top + 1.0  # at 1 m/200 kN
+    scale = _arrow_scale(step_run, [i], None)
+    assert scale < G.FORCE_SCALE
+    tips = g["wheel_arrow_origin"][0] + g["wheel_arrow_vector"][0] * (scale / G.FORCE_SCALE)
+    assert float(tips[:, 1].max()) <= top
+    fig, ax = plt.subplots()
+    draw_configuration(ax, step_run, i, force_scale=scale)
+    low, high = ax.get_ylim()
+    ground = G.ground_polyline(step_run)
+    assert low >= float(ground[:, 1].min()) - 0.45 and high == pytest.approx(top)   # not the ground arrow's tail
+    plt.close(fig)
+    assert _arrow_scale(step_run, [0], None) == G.FORCE_SCALE     # standing still: the paper's scale
+
+
+def test_run_titles_name_the_run(step_run, tmp_path):
+    from trackbench.replay.plots import run_label
+    d = tmp_path / "speed_sweep" / "runs" / "abcdef0123456789"
+    write_netcdf(step_run, d / "timeseries.nc")
+    (d / "run.json").write_text(json.dumps({"run_id": "abcdef0123456789", "study": "speed_sweep", "replicate": 0,
+                                            "params": {"speed": 12.5, "terrain.height": 0.1,
+                                                       "idler.preload": 150000.0, "drawbar.slip": 0.05}}))
+    assert run_label(step_run, d) == ("speed_sweep run abcdef01: speed 12.5 m/s, terrain.height 0.1 m, "
+                                      "idler.preload 150 kN, drawbar.slip 5 %")
+    assert run_label(step_run, d / "timeseries.nc") == run_label(step_run, d)
+    assert run_label(step_run) == "paper_step"        # no study around it: the scenario's name
 
 
 def test_plot_run_from_a_run_folder(run_folder, tmp_path):
@@ -222,6 +285,59 @@ def test_plot_study_one_figure_per_axis(tmp_path):
     res = CliRunner().invoke(app, ["plot", str(tmp_path / "st")])
     assert res.exit_code == 0, res.output
     assert (tmp_path / "st" / "plots" / "study_speed.png").exists()
+
+
+def test_study_axes_have_units_and_readable_values():
+    from trackbench.replay.plots import axis_label, parameter_unit, value_label
+    assert [parameter_unit(k) for k in ("speed", "idler.preload", "drive.torque", "terrain.height",
+                                        "vehicle.torsion_stiffness", "contact.friction_stiffness")] == \
+        ["m/s", "N", "N m", "m", "N m/rad", "N/m"]
+    assert parameter_unit("contact.friction") == "" and parameter_unit("preset") == ""
+    assert axis_label("idler.preload", [1.2e5, 1.8e5]) == "idler.preload (kN)"
+    assert axis_label("drawbar.slip", [0.05, 0.5]) == "drawbar.slip (%, at the sprocket)"
+    bump = json.dumps({"height": 0.1, "kind": "bump", "length": 0.6, "position": 3.5})
+    assert value_label("terrain", bump) == "bump 0.1 m x 0.6 m"
+    assert value_label("terrain", {"kind": "flat", "soil": "lete_sand"}) == "flat, lete_sand"
+
+
+def test_study_draws_a_line_per_value_of_the_other_axis(tmp_path):
+    from trackbench.replay.plots import _groups
+    fake_summary(tmp_path / "st")
+    df = pd.read_csv(tmp_path / "st" / "summary.csv")
+    groups, too_many = _groups(df, ["terrain.height"], df["speed"].to_numpy(float))
+    assert [g[0] for g in groups] == ["terrain.height 0.05 m", "terrain.height 0.1 m"] and not too_many
+    assert [int(g[1].sum()) for g in groups] == [3, 3]
+    # more combinations than MAX_LINES: one median line over them
+    many = pd.DataFrame({"speed": np.repeat([5.0, 10.0], 8), "h": np.tile(np.arange(8.0), 2)})
+    groups, too_many = _groups(many, ["h"], many["speed"].to_numpy())
+    assert len(groups) == 1 and groups[0][0] is None and too_many
+
+
+def test_study_terrain_axis_gets_short_labels(tmp_path):
+    rows = []
+    for k, t in enumerate([None, None, {"kind": "bump", "height": 0.1, "length": 0.6, "position": 3.5},
+                           {"kind": "bump", "height": 0.2, "length": 0.6, "position": 3.5}]):
+        rows.append({"run_id": f"r{k}", "status": "completed", "terrain.height": 0.05 * (k + 1) if t is None else np.nan,
+                     "terrain": json.dumps(t, sort_keys=True) if t else np.nan, "peak_wheel1_force_y": 1e5 * (k + 1)})
+    (tmp_path / "st").mkdir()
+    pd.DataFrame(rows).to_csv(tmp_path / "st" / "summary.csv", index=False)
+    (tmp_path / "st" / "runs.json").write_text(json.dumps({"runs": [
+        {"run_id": f"r{k}", "scenario": {"terrain": {"kind": "step", "height": 0.05 * (k + 1)}}} for k in range(2)]}))
+    import matplotlib.pyplot as plt
+    made = []
+    monkey = plt.Figure.savefig
+
+    def keep(fig, path, **kw):
+        made.append([t.get_text() for t in fig.axes[-1].get_xticklabels()])
+        return monkey(fig, path, **kw)
+
+    plt.Figure.savefig = keep
+    try:
+        paths = plot_study(tmp_path / "st", tmp_path / "out")
+    finally:
+        plt.Figure.savefig = monkey
+    assert [p.name for p in paths] == ["study_terrain_height.png", "study_terrain.png"]
+    assert made[1] == ["bump 0.1 m x 0.6 m", "bump 0.2 m x 0.6 m", "step 0.05 m", "step 0.1 m"]
 
 
 def test_view_resolves_paths_and_explains_missing_display(run_folder, monkeypatch):
@@ -351,6 +467,15 @@ def test_closed_recording_thinned_and_without_rollers(closed_run, tmp_path):
     assert len(data[R.E_IDLER_FORCE][R.TIMELINE]) == ds.sizes["time"]
 
 
+def test_closed_run_draws_the_drive(closed_run, tmp_path):
+    import matplotlib.image as mpimg
+    paths = plot_run(closed_run, tmp_path)
+    names = [p.name for p in paths]
+    assert "drive.png" in names and "traction.png" not in names     # rigid ground, no drawbar
+    img = mpimg.imread(tmp_path / "drive.png")
+    assert img.shape[0] > 800 and np.mean(np.any(img[..., :3] < 0.9, axis=-1)) > 0.03
+
+
 def test_closed_configuration_png(closed_run, tmp_path):
     import matplotlib.image as mpimg
     from trackbench.replay.plots import plot_configuration
@@ -454,6 +579,15 @@ def test_rigid_runs_log_no_soil(run_folder, step_run):
     assert not G.is_soil(step_run)
     rrd = run_folder / "recording.rrd"
     assert R.E_SOIL not in read_temporal(rrd) and R.E_SOIL not in static_entities(rrd)
+
+
+def test_soil_run_draws_sinkage_and_pull(soil_run, tmp_path):
+    import matplotlib.image as mpimg
+    names = [p.name for p in plot_run(soil_run, tmp_path)]
+    assert "traction.png" in names and "drive.png" not in names     # the paper's layout has no sprocket
+    img = mpimg.imread(tmp_path / "traction.png")
+    assert img.shape[0] > 600 and np.mean(np.any(img[..., :3] < 0.9, axis=-1)) > 0.03
+    assert np.max(soil_run["sinkage"].values) > 0.0
 
 
 def test_soil_configuration_png_shows_the_rut(soil_run, step_run, tmp_path):
