@@ -1,0 +1,198 @@
+"""What the run and study figures share: matplotlib's lazy import, finding and loading a run,
+the words and units of parameters and values (axis labels, run titles). matplotlib is an
+optional dependency (extra "plot"); it is imported only when a figure is drawn."""
+
+import json
+import re
+import textwrap
+from pathlib import Path
+
+import numpy as np
+
+from . import geometry as G
+
+PAPER_TIMES = (0.1, 0.35, 0.45)   # the paper's Figs. 8-10 (a 0.5 s run)
+DPI = 130
+SOIL_DENT = "#f2dc9b"   # soft soil: the rut, between the original surface and the dent
+
+
+def _plt():
+    try:
+        import matplotlib
+    except ImportError as e:  # pragma: no cover - depends on the install
+        raise ImportError("plotting needs matplotlib: pip install 'trackbench[plot]'") from e
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def find_timeseries(path):
+    """A .nc file, or a run folder holding timeseries.nc (or exactly one .nc) -> the .nc Path."""
+    path = Path(path)
+    if path.is_file():
+        return path
+    if path.is_dir():
+        if (path / "timeseries.nc").exists():
+            return path / "timeseries.nc"
+        ncs = sorted(path.glob("*.nc"))
+        if len(ncs) == 1:
+            return ncs[0]
+        if len(ncs) > 1:
+            raise FileNotFoundError(f"{path} holds several .nc files ({', '.join(p.name for p in ncs)}); give one")
+        raise FileNotFoundError(f"{path} holds no timeseries.nc (nor any .nc file)")
+    raise FileNotFoundError(f"{path} does not exist")
+
+
+def load_run(ds_or_path):
+    """A Dataset is returned as is; a path (a .nc file or a run folder) is loaded into memory."""
+    if hasattr(ds_or_path, "data_vars"):
+        return ds_or_path
+    import xarray as xr
+    return xr.load_dataset(find_timeseries(ds_or_path))
+
+
+def _wheels_to_show(ds):
+    """The paper shows wheels 1, 3 and 5; for other vehicles: the first, middle and last."""
+    w = [int(x) for x in ds["wheel"].values]
+    if {1, 3, 5} <= set(w):
+        return [1, 3, 5]
+    return sorted({w[0], w[len(w) // 2], w[-1]})
+
+
+def _name(ds):
+    try:
+        return G.scenario_of(ds).get("name", "run")
+    except (KeyError, ValueError):
+        return "run"
+
+
+def _wrap(text, width=95):
+    """Long titles broken into lines (each paragraph on its own)."""
+    return "\n".join(textwrap.fill(line, width) for line in text.split("\n"))
+
+
+# ------------------------------------------------------------ parameters and their units ----
+
+# units of parameters whose rule text (trackbench/scenario.py) names none
+_UNITS = {"output_interval": "s", "vehicle.chassis_mass": "kg", "vehicle.chassis_inertia": "kg m^2",
+          "vehicle.arm_mass": "kg", "vehicle.arm_inertia": "kg m^2", "vehicle.arm_length": "m",
+          "vehicle.torsion_stiffness": "N m/rad", "vehicle.wheel_radius": "m", "vehicle.pivot_spacing": "m",
+          "track.link_length": "m", "track.pin_mass": "kg", "track.link_stiffness": "N/m", "track.pad_wheel": "m",
+          "track.pad_ground": "m", "track.wheel_stiffness": "N/m", "track.ground_stiffness": "N/m",
+          "sprocket.seat_radius": "m", "sprocket.pin_radius": "m", "sprocket.stiffness": "N m/rad",
+          "sprocket.inertia": "kg m^2", "idler.radius": "m", "idler.mass": "kg", "idler.stiffness": "N/m",
+          "idler.damping": "N s/m", "idler.travel": "m", "rollers.radius": "m", "drive.gain_p": "N m s/rad",
+          "drive.gain_i": "N m/rad", "drive.torque_limit": "N m", "terrain.gap": "m"}
+_UNIT_PARTS = {"m", "s", "N", "kg", "deg", "rad", "Pa", "kPa", "2", "3"}
+
+
+def _is_unit(text):
+    parts = [x for x in re.split(r"[ /^]", text.strip()) if x]
+    return bool(parts) and all(x in _UNIT_PARTS for x in parts)
+
+
+def parameter_unit(name):
+    """The unit of a scenario parameter ('' when it has none): from its rule's text in
+    trackbench/scenario.py ("a number in [0, 100] m/s", "(N; 0: derived ...)"), else from a
+    table of the parameters whose rule text names none."""
+    from ..scenario import RULES, TERRAIN_RULES
+    rule = RULES.get(name) or (TERRAIN_RULES.get(name[len("terrain."):]) if name.startswith("terrain.") else None)
+    text = rule[3] if rule else ""
+    m = re.search(r"[\])]\s+([^(;:]+?)\s*(?:\(|$)", text)
+    if m and _is_unit(m.group(1)):
+        return m.group(1).strip()
+    for m in re.finditer(r"\(([^;:,()]+)[;:,)]", text):
+        if _is_unit(m.group(1)):
+            return m.group(1).strip()
+    return _UNITS.get(name, "")
+
+
+def display_scale(name, values=()):
+    """(factor, unit) a parameter is shown in: slips in %, forces of 10 kN and more in kN,
+    torques in kN m; else (1, its unit)."""
+    if name.endswith("slip"):
+        return 100.0, "%"
+    unit = parameter_unit(name)
+    big = np.nanmax(np.abs(np.asarray(values, dtype=float))) >= 1e4 if len(values) else False
+    if unit in ("N", "N m") and big:
+        return 1e-3, "k" + unit
+    return 1.0, unit
+
+
+def axis_label(name, values=()):
+    k, unit = display_scale(name, values)
+    extra = ", at the sprocket" if name == "drawbar.slip" else ""
+    return f"{name} ({unit}{extra})" if unit else name
+
+
+def _parsed(value):
+    if isinstance(value, str) and value[:1] in "{[":
+        try:
+            return json.loads(value)
+        except ValueError:
+            return value
+    return value
+
+
+def terrain_label(t):
+    """A short name of a terrain table: kind, height (and length), soil."""
+    if not isinstance(t, dict):
+        return str(t)
+    kind = t.get("kind", "terrain")
+    if kind == "sequence":
+        text = " + ".join(terrain_label(o) for o in t.get("obstacles", []))[:60] or "sequence"
+    elif kind == "points":
+        text = f"points ({len(t.get('points', []))})"
+    else:
+        text = kind
+        if "height" in t:
+            text += f" {float(t['height']):g} m"
+        if "length" in t:
+            text += f" x {float(t['length']):g} m"
+    soil = t.get("soil")
+    if soil not in (None, "rigid"):
+        text += f", {soil if isinstance(soil, str) else 'soil table'}"
+    return text
+
+
+def value_label(name, value):
+    """A parameter's value for a title, a legend or a tick: '12.5 m/s', 'bump 0.1 m x 0.6 m'."""
+    v = _parsed(value)
+    if isinstance(v, dict):
+        return terrain_label(v)
+    if isinstance(v, (list, tuple)):
+        return json.dumps(v, separators=(",", ":"))[:30]
+    if isinstance(v, (bool, np.bool_)) or isinstance(v, str):
+        return str(v)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    k, unit = display_scale(name, [x])
+    return f"{x * k:g} {unit}".strip()
+
+
+def run_label(ds, path=None):
+    """What a run's figure titles start with: the study, the run id and the run's grid values
+    (run.json beside a study's timeseries.nc), e.g. 'speed_sweep run 1a2b3c4d: speed 12.5 m/s,
+    terrain.height 0.1 m'; a run outside a study: its scenario's name."""
+    name = _name(ds)
+    if path is None:
+        return name
+    try:
+        rec = json.loads((find_timeseries(path).parent / "run.json").read_text())
+    except (OSError, ValueError):
+        return name
+    text = f"{rec.get('study', name)} run {str(rec.get('run_id', ''))[:8]}".rstrip()
+    params = rec.get("params") or {}
+    if rec.get("replicate"):
+        params = {**params, "replicate": rec["replicate"]}
+    if params:
+        text += ": " + ", ".join(f"{k} {value_label(k, v)}" for k, v in params.items())
+    return text
+
+
+def _status_note(ds):
+    if ds.attrs.get("status", "completed") == "completed":
+        return ""
+    return f"  [run {ds.attrs.get('status')} at t = {float(ds.attrs.get('t_final', np.nan)):.4f} s]"
