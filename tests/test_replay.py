@@ -602,3 +602,15 @@ def test_soil_configuration_png_shows_the_rut(soil_run, step_run, tmp_path):
     soil = plot_configuration(soil_run, (0.0, 0.05), tmp_path / "soil.png")
     rigid = plot_configuration(step_run, (0.0, 0.1), tmp_path / "rigid.png")
     assert share(soil) > 0.0005 and share(rigid) == 0.0
+
+
+def test_plotting_a_file_that_is_not_a_run_says_so_in_one_line(tmp_path):
+    from trackbench.replay.plots import plot_run
+    junk = tmp_path / "junk.nc"
+    junk.write_text("not netCDF")
+    with pytest.raises(ValueError, match=r"junk.nc is not a netCDF file trackbench can read"):
+        plot_run(junk, tmp_path / "p")
+    import xarray as xr
+    xr.Dataset({"a": ("x", [1.0, 2.0])}).to_netcdf(tmp_path / "other.nc")
+    with pytest.raises(ValueError, match=r"other.nc is a netCDF file but not a trackbench run"):
+        plot_run(tmp_path / "other.nc", tmp_path / "p")

@@ -48,7 +48,15 @@ def load_run(ds_or_path):
     if hasattr(ds_or_path, "data_vars"):
         return ds_or_path
     import xarray as xr
-    return xr.load_dataset(find_timeseries(ds_or_path))
+    path = find_timeseries(ds_or_path)
+    try:
+        ds = xr.load_dataset(path)
+    except (ValueError, OSError) as e:    # xarray's "did not find a match in any of ... IO backends"
+        raise ValueError(f"{path} is not a netCDF file trackbench can read ({type(e).__name__}); give a run's "
+                         ".nc file or its folder") from None
+    if "time" not in ds.dims or "scenario" not in ds.attrs:
+        raise ValueError(f"{path} is a netCDF file but not a trackbench run (no time dimension or scenario)")
+    return ds
 
 
 def _wheels_to_show(ds):
