@@ -133,6 +133,19 @@ def _check_name(where, name):
     raise StudyError(f"{where}: unknown parameter '{name}'{hint}")
 
 
+def _unquoted_dotted(where, name, value):
+    """An unquoted dotted key of an axis (terrain.height = [...]) reaches here as a table
+    {'height': [...]} under 'terrain': say to quote it instead of reading it as a range."""
+    if not isinstance(value, dict) or all(k in RANGE_KEYS for k in value):
+        return
+    if name != "terrain" and not any(p.startswith(name + ".") for p in parameter_names()):
+        return
+    k, v = next((k, v) for k, v in value.items() if k not in RANGE_KEYS)
+    dotted = f"{name}.{k}"
+    raise StudyError(f"{where}: {dotted} = ... is read by TOML as a table '{name}'; quote dotted names: "
+                     f'"{dotted}" = {_toml_value(v) if not isinstance(v, dict) else "[...]"}')
+
+
 def _param_value(v):
     """A summary-friendly value: scalars as they are, tables and lists as JSON text."""
     if isinstance(v, (dict, list)):
@@ -150,6 +163,7 @@ def _variants(doc, path):
         if not grid:
             raise StudyError(f"{path}: [grid] is empty: give at least one axis, e.g. speed = [5.0, 10.0]")
         for name, value in flatten_axes(grid).items():
+            _unquoted_dotted(f"{path}: [grid]", name, value)
             _check_name(f"{path}: [grid]", name)
             axes[name] = _axis_values(f"{path}: [grid] {name}", value)
     zdoc = doc.get("zip", [])
@@ -162,6 +176,7 @@ def _variants(doc, path):
             raise StudyError(f"{where} is empty: give two or more axes of equal length")
         g = {}
         for name, value in flatten_axes(group).items():
+            _unquoted_dotted(where, name, value)
             _check_name(where, name)
             if name in axes or any(name in z for z in zips):
                 raise StudyError(f"{where}: '{name}' is varied twice (in [grid] or another [[zip]])")
