@@ -41,3 +41,26 @@ def atomic_path(path):
             os.truncate(tmp, 0)   # frees its space even when a failed writer still holds it open
             os.remove(tmp)
         raise
+
+
+def writable_folder(path):
+    """Make sure ``path`` is a folder this process can write files into (created when missing),
+    before any work starts; raises ValueError with one line naming the path and the problem."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{path} is a file, not a folder: give a folder path")
+    parent = Path(os.path.abspath(path))
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{path} cannot be created: {parent} is a file, not a folder")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise ValueError(f"{path} cannot be created in {parent}: {e.strerror or e}") from None
+    try:
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as e:
+        raise ValueError(f"{path} is not writable: {e.strerror or e}") from None
+    return path

@@ -4,6 +4,7 @@
 """
 
 import os
+import re
 import socket
 import sys
 import time
@@ -11,7 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import executors, store
-from .spec import Study, load_study, resolved_toml
+from .spec import Study, StudyError, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
 
@@ -56,11 +57,57 @@ class Outcome:
 
 def manifest(study):
     """runs.json: the study's runs as expanded now, so the folder can be read later even when
-    the package's defaults (and so a re-expansion's run ids) have changed."""
-    return {"name": study.name, "description": study.description, "replicates": study.replicates,
+    the package's defaults (and so a re-expansion's run ids) have changed; ``source`` is the
+    study file (absolute), which the folder belongs to (check_output)."""
+    return {"name": study.name, "source": os.path.abspath(study.source), "description": study.description, "replicates": study.replicates,
             "storage": study.storage, "param_names": study.param_names,
             "runs": [{"run_id": r.run_id, "index": r.index, "variant": r.variant, "replicate": r.replicate,
                       "params": r.params, "scenario": r.scenario} for r in study.runs]}
+
+
+def recorded_source(output):
+    """The study file a results folder belongs to, as (path, exact): runs.json's ``source``
+    (exact), else the path in study.toml's first line (as it was given: relative paths are
+    compared by file name), else None (a new folder)."""
+    m = store.read_json(Path(output) / "runs.json")
+    if isinstance(m, dict) and m.get("source"):
+        return m["source"], True
+    try:
+        with open(Path(output) / "study.toml") as f:
+            first = f.readline()
+    except OSError:
+        return None
+    m = re.match(r"# resolved copy of (.*): \d+ runs$", first.rstrip("\n"))
+    return (m.group(1), os.path.isabs(m.group(1))) if m else None
+
+
+def _same_file(a, b):
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_output(study):
+    """Raise StudyError (one line) when the study's results folder cannot be used: it cannot be
+    created or written, or it holds the results of another study file (whose study.toml,
+    runs.json and summary this run would replace). The same file, edited or not, resumes."""
+    from ..atomic import writable_folder
+    try:
+        writable_folder(study.output)
+    except ValueError as e:
+        raise StudyError(f"{study.source}: results folder {e}") from None
+    rec = recorded_source(study.output)
+    if rec is None or study.source is None:
+        return
+    owner, exact = rec
+    same = _same_file(owner, study.source) if exact else Path(owner).name == Path(study.source).name
+    if not same:
+        raise StudyError(f"{study.output} holds the results of another study file, {owner}; running "
+                         f"{study.source} there would replace them: give {study.source} another [study] name (or "
+                         f"output), or run it with --output FOLDER")
 
 
 def plan(study, force=False):
@@ -142,8 +189,10 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
     the same folder. ``storage`` ("full" or "compact") overrides the study's [study] storage."""
     t0 = time.perf_counter()
     study = _prepare(path, workers, executor, scheduler, output, storage)
+    check_output(study)
     out = Outcome(study=study)
     with store.study_lock(study.output):
+        check_output(study)   # again under the lock: another study may have taken the folder meanwhile
         store.clean_tmp(study.output)
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
