@@ -1,6 +1,7 @@
 """Reading a study: the pandas summary, replicate statistics, open_study / open_study_dataset."""
 
 import importlib.util
+import os
 from pathlib import Path
 
 import numpy as np
@@ -8,7 +9,7 @@ import pandas as pd
 
 from .. import quantities as Q
 from . import store
-from .spec import Run, Study, load_study
+from .spec import Run, Study, StudyError, load_study
 
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
 # the results in the study table on screen, in its column order (vertical acceleration as min, max)
@@ -133,6 +134,31 @@ def _study_of(path):
                   replicates=m["replicates"], base={}, param_names=m["param_names"])
     study.runs = [Run(**r) for r in m["runs"]]
     return study
+
+
+def missing_folder(study):
+    """'<folder> does not exist (why it was looked for there)': a study file's missing results folder."""
+    out = Path(study.output)
+    where = "" if out.is_absolute() else (" ([study] output is relative to the directory `study run` ran in: "
+                                          "run this there, or give the results folder)")
+    return f"{os.path.abspath(out)} does not exist{where}"
+
+
+def study_folder(path):
+    """A study file or its results folder -> (study, results folder); StudyError (one line)
+    when the path or the results folder does not exist. A study file's folder is its [study]
+    output (default results/<name>) relative to the current directory, as `study run` puts it."""
+    path = Path(path)
+    if not path.exists():
+        raise StudyError(f"{path} does not exist")
+    if path.is_dir():
+        if not ((path / "runs.json").is_file() or (path / "study.toml").is_file()):
+            raise StudyError(f"{path} is not a study results folder (no runs.json or study.toml inside)")
+        return _study_of(path), path
+    study = load_study(path)
+    if not Path(study.output).is_dir():
+        raise StudyError(f"no results of study {study.name}: {missing_folder(study)}")
+    return study, Path(study.output)
 
 
 def open_run(path, run):
