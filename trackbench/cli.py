@@ -7,6 +7,7 @@ import typer
 
 app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="Dynamics of high-mobility tracked vehicles (K. Lee, 2000).")
+STORAGE = "full|compact"
 study_app = typer.Typer(no_args_is_help=True, help="Run and read parameter studies (TOML).")
 app.add_typer(study_app, name="study")
 
@@ -16,14 +17,28 @@ def _fail(msg: str, code: int = 2):
     raise typer.Exit(code)
 
 
+def _version(value: bool):
+    if value:
+        from .version import MODEL_VERSION, __version__
+        typer.echo(f"trackbench {__version__} (model version {MODEL_VERSION})")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", metavar="", callback=_version, is_eager=True,
+                                       help="Print the version and exit.")):
+    """Dynamics of high-mobility tracked vehicles (K. Lee, 2000)."""
+
+
 @app.command()
 def run(
-    set_: List[str] = typer.Option([], "--set", "-s", help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15"),
+    set_: List[str] = typer.Option([], "--set", "-s", metavar="NAME=VALUE", help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15"),
     duration: Optional[float] = typer.Option(None, help="Simulated time (s); default: the scenario's (0.5 s)."),
-    out: Path = typer.Option(Path("out"), "--out", "-o", help="Folder for the netCDF file."),
-    name: str = typer.Option("paper_step", help="Scenario name, used for the file name."),
-    force: bool = typer.Option(False, "--force", help="Replace OUT/NAME.nc (and .rrd) if they exist."),
-    storage: str = typer.Option("full", help="full (lossless) or compact (time histories at the resolution "
+    out: Path = typer.Option(Path("out"), "--out", "-o", help="Folder for the netCDF file and the recording."),
+    name: Optional[str] = typer.Option(None, help="Scenario name, used for the file names; default: "
+                                                  "--set name=..., else paper_step."),
+    force: bool = typer.Option(False, "--force", metavar="", help="Replace OUT/NAME.nc (and .rrd) if they exist."),
+    storage: str = typer.Option("full", metavar=STORAGE, help="full (lossless) or compact (time histories at the resolution "
                                              "results_schema.md states, a thinner recording)."),
 ):
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
@@ -50,10 +65,20 @@ def params():
 
 # --- study commands ----------------------------------------------------------------
 
-def _load_study_or_fail(file: Path):
+def _load_study_or_fail(file: Path, output: Optional[Path] = None):
     from .study import StudyError, load_study
     try:
-        return load_study(file)
+        return load_study(file, output=output)
+    except StudyError as e:
+        _fail(str(e))
+
+
+def _study_folder_or_fail(path: Path):
+    """A study file or results folder -> (study, its results folder, which exists)."""
+    from .study import StudyError
+    from .study.summary import study_folder
+    try:
+        return study_folder(path)
     except StudyError as e:
         _fail(str(e))
 
@@ -62,18 +87,23 @@ def _load_study_or_fail(file: Path):
 def study_run(
     file: Path = typer.Argument(..., help="Study file (TOML), e.g. studies/speed_sweep.toml."),
     workers: int = typer.Option(2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."),
-    executor: str = typer.Option("local", help="local (process pool) or dask (dask.distributed)."),
+    executor: str = typer.Option("local", metavar="local|dask", help="local (process pool) or dask (dask.distributed)."),
     scheduler: Optional[str] = typer.Option(None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."),
-    force: bool = typer.Option(False, "--force", help="Rerun every run, also those already completed."),
-    storage: Optional[str] = typer.Option(None, help="full (lossless) or compact (time histories at the resolution "
-                                                     "results_schema.md states); default: the study's [study] storage, "
+    force: bool = typer.Option(False, "--force", metavar="", help="Rerun every run, also those already completed."),
+    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Results folder; default: the study's "
+                                          "\\[study] output, else results/NAME (relative to the current directory)."),
+    storage: Optional[str] = typer.Option(None, metavar=STORAGE, help="full (lossless) or compact (time histories "
+                                                     "at the resolution results_schema.md states); default: the "
+                                                     "study's \\[study] storage, "
                                                      "else full. Runs already completed keep their files."),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    study = _load_study_or_fail(file)   # a bad study file fails here, before the solver libraries load
+    study = _load_study_or_fail(file, output)   # a bad study file fails here, before the solver libraries load
     from .study.executors import check_arguments, start_workers
+    from .study.runner import check_output
     try:
         check_arguments(workers, executor, scheduler, storage)
+        check_output(study)   # a folder that cannot be written, or that holds another study's results
     except ValueError as e:
         _fail(str(e))
     from .study import store
@@ -98,21 +128,23 @@ def study_run(
 
 
 @study_app.command("summary")
-def study_summary(file: Path = typer.Argument(..., help="Study file (TOML).")):
+def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
     """Print the study's summary table (rebuilt from the runs' run.json; summary files rewritten)."""
     from .study.summary import format_table, write_summary
-    study = _load_study_or_fail(file)
-    if not study.output.is_dir():
-        _fail(f"no results yet for study {study.name} (looked in {study.output}); run: trackbench study run {file}")
+    study, _ = _study_folder_or_fail(file)
     df, rep = write_summary(study)
     typer.echo(format_table(df, rep, study.param_names))
 
 
 @study_app.command("status")
-def study_status(file: Path = typer.Argument(..., help="Study file (TOML).")):
+def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
     """Show how many runs are done, failed and pending."""
     from .study.runner import status_counts
-    study = _load_study_or_fail(file)
+    from .study.summary import missing_folder
+    study = _study_folder_or_fail(file)[0] if file.is_dir() else _load_study_or_fail(file)
+    if not study.output.is_dir():
+        typer.echo(f"study {study.name}: {len(study.runs)} runs, all pending: {missing_folder(study)}")
+        return
     counts, df = status_counts(study)
     typer.echo(f"study {study.name}: {len(study.runs)} runs: {counts['completed']} done, {counts['failed']} failed, "
                f"{counts['pending']} pending ({study.output})")
@@ -130,6 +162,8 @@ def view(
 ):
     """Open the rerun viewer on a run's recording (needs a display; otherwise says how to open it elsewhere)."""
     from .replay.view import ViewError, open_viewer
+    if path.suffix == ".toml" and path.is_file():
+        path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
     try:
         code = open_viewer(path, run_id)
     except (ViewError, ValueError) as e:
@@ -151,13 +185,14 @@ def plot(
     except ValueError:
         _fail(f"--times {times!r}: expected numbers separated by commas, e.g. 0.1,0.35,0.45")
     is_study = path.suffix == ".toml" or (path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir()))
+    if path.suffix == ".toml":
+        path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
     if out is None:
         out = (path.parent / (path.stem + "_plots")) if path.is_file() and path.suffix == ".nc" else None
     try:
         if is_study:
             if out is None:
-                from .replay.view import study_output
-                out = (study_output(path) if path.suffix == ".toml" else path) / "plots"
+                out = path / "plots"
             paths = plot_study(path, out)
         else:
             paths = plot_run(path, out if out is not None else path / "plots", times=tt)

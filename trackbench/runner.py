@@ -85,40 +85,69 @@ def format_summary(ds, path=None):
     if shown(compression.name) == shown(compression.name):   # a link went into compression
         lines.append("  note: peaks after the first compression are sensitive to tiny changes (chaotic motion); "
                      "compare them as ranges.")
-    if path:
-        lines.append(f"  written: {path}")
+    for p in ([path] if isinstance(path, (str, Path)) else path or []):
+        lines.append(f"  written: {p}")
     return "\n".join(lines)
 
 
-def run_one(sets, duration, out, name, force=False, storage="full"):
+DEFAULT_NAME = "paper_step"
+
+
+def run_name(name, sc):
+    """The run's name (the file name): --name, else --set name=..., else paper_step; one that
+    would not be a plain file name raises ScenarioError."""
+    given = sc.to_dict().get("name")
+    if name is not None and given not in (None, DEFAULT_NAME, name):
+        raise ScenarioError(f"--name {name!r} and --set name={given!r} disagree: give the name once")
+    name = name if name is not None else (given or DEFAULT_NAME)
+    if not name or name.startswith(".") or any(c in name for c in "/\\\0") or not name.isprintable():
+        raise ScenarioError(f"name {name!r} is not allowed: it names the files, so no /, \\, leading dot "
+                            "or control characters, e.g. --name fast_step")
+    return name
+
+
+def run_one(sets, duration, out, name=None, force=False, storage="full"):
     """Run, write OUT/NAME.nc (+ NAME.rrd) as ``storage`` says (trackbench/storage.py); a
     failed run is kept for diagnosis as NAME.failed.nc, never under the name of a complete
-    result. Existing files of that name are only replaced with force. Returns (text, ok)."""
+    result. Existing files of that name are only replaced with force. NAME: ``name``, else the
+    scenario's name (--set name=...), else paper_step. Returns (text, ok)."""
+    from .atomic import writable_folder
     from .storage import check_storage
     try:
         check_storage(storage)
     except ValueError as e:
         raise ScenarioError(str(e)) from None
     sc = scenario_from_sets(sets, duration)   # bad input fails here, before the solver libraries load
+    name = run_name(name, sc)
     sc = sc.with_overrides({"name": name})
+    try:
+        writable_folder(out)
+    except ValueError as e:
+        raise ScenarioError(f"--out {e}") from None
+    targets = [Path(out) / f"{name}{ext}" for ext in (".nc", ".rrd", ".failed.nc")]
+    existing = [p for p in targets if p.exists()]
+    if existing and not force:
+        hint = "give this run its own name with --name NAME" if name == DEFAULT_NAME else "choose another --name"
+        raise ScenarioError(f"{existing[0]} exists: {hint} (or another --out), or --force to replace it")
     from .output import write_netcdf
     from .replay.record import maybe_write_recording
     from ._jitcache import CompileNotice
     from .simulate import simulate
-    targets = [Path(out) / f"{name}{ext}" for ext in (".nc", ".rrd", ".failed.nc")]
-    existing = [p for p in targets if p.exists()]
-    if existing and not force:
-        raise ScenarioError(f"{existing[0]} exists: choose another --name or --out, or --force to replace it")
     with CompileNotice(sys.stderr) as compiled:
         ds = simulate(sc)
     ok = ds.attrs["status"] == "completed"
     path = write_netcdf(ds, targets[0] if ok else targets[2], storage)
     for stale in existing:
-        if stale != path:
+        if stale != path and not (ok and stale == targets[1]):
             stale.unlink(missing_ok=True)
+    paths = [path]
     if ok:
-        maybe_write_recording(ds, Path(out), name=f"{name}.rrd", storage=storage)
-    text = format_summary(ds, path)
+        rrd = maybe_write_recording(ds, Path(out), name=f"{name}.rrd", storage=storage)
+        if rrd is None:
+            targets[1].unlink(missing_ok=True)   # recording off: no stale recording of an earlier run beside it
+        else:
+            paths.append(rrd)
+    text = format_summary(ds, paths)
     if compiled.seconds > 0.0:
         text += f"\n  of the wall time, {compiled.seconds:.1f} s compiling (once: later runs load the model from the cache)"
     return text, ok
