@@ -107,6 +107,12 @@ BAD = [
     ("[grid]\nspeed = [5.0, 10.0, 5.0]\n", r"duplicate runs: run 1 and run 3 resolve to the same scenario \(speed = 5.0\)"),
     ("[[zip]]\nspeed = [5.0, 6.0]\n\"terrain.height\" = [0.1]\n", r"zipped axes must have equal lengths, got speed: 2, terrain.height: 1"),
     ("[grid]\n\"track.link_length\" = [0.15]\n", r"track\.link_length|track is too short"),
+    # unquoted dotted axes are tables to TOML: say to quote them
+    ("[grid]\nterrain.height = [0.05, 0.1]\n", r"\[grid\]: terrain\.height = \.\.\. is read by TOML as a table "
+                                                 r"'terrain'; quote dotted names: \"terrain\.height\" = \[0\.05, 0\.1\]"),
+    ("[grid]\ncontact.friction = [0.1, 0.2]\n", r"quote dotted names: \"contact\.friction\" = \[0\.1, 0\.2\]"),
+    ("[[zip]]\nspeed = [1.0, 2.0]\nterrain.height = { start = 0.05, stop = 0.1, num = 2 }\n",
+     r"\[\[zip\]\] #1: terrain\.height = \.\.\. is read by TOML as a table 'terrain'; quote dotted names"),
 ]
 
 
