@@ -176,12 +176,14 @@ def plot(
     path: Path = typer.Argument(..., help="A run (.nc file or run folder) or a study (results folder or TOML)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", help="Folder for the PNG files; default: "
                                        "RUN_FOLDER/plots, NAME_plots beside a .nc file, STUDY/plots."),
-    times: str = typer.Option("0.1,0.35,0.45", help="Times (s) of the configuration figure, comma-separated."),
+    times: Optional[str] = typer.Option(None, help="Times (s) of the configuration figure, comma-separated; "
+                                         "default: the paper's 0.1,0.35,0.45 for a run of its length, else three "
+                                         "times spread over the run."),
 ):
     """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
     from .replay.plots import plot_run, plot_study
     try:
-        tt = tuple(float(x) for x in times.split(",") if x.strip())
+        tt = None if times is None else tuple(float(x) for x in times.split(",") if x.strip())
     except ValueError:
         _fail(f"--times {times!r}: expected numbers separated by commas, e.g. 0.1,0.35,0.45")
     is_study = path.suffix == ".toml" or (path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir()))

@@ -227,12 +227,10 @@ def plot_run(ds_or_path, out_dir, times=None, label=None):
     energy.png         energies and the energy-balance deviation (Fig. 18)
     drive.png          closed track: sprocket torque, track and chassis speed, idler force
     traction.png       soft soil or a drawbar: slip, drawbar pull, deepest sinkage
-    times None (or the paper's times, which `trackbench plot` passes when --times is not
-    given): default_times(ds); given times outside the run are left out (said in the title).
+    times None: default_times(ds); given times outside the run are left out (said in the
+    title).
     Titles start with `label`, default run_label: the study, run id and grid values."""
     ds = load_run(ds_or_path)
-    if times is not None and tuple(float(x) for x in times) == PAPER_TIMES:
-        times = None
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     name = label or run_label(ds, None if hasattr(ds_or_path, "data_vars") else ds_or_path)
