@@ -14,7 +14,8 @@ from .spec import Run, Study, StudyError, load_study
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
 # the results in the study table on screen, in its column order (vertical acceleration as min, max)
 SCREEN = ("peak_wheel_force_y", "peak_ground_force_y", "peak_link_tension", "min_chassis_ay", "peak_chassis_ay",
-          "min_chassis_vx", "first_compression_time", "peak_sprocket_torque", "peak_idler_force")
+          "min_chassis_vx", "first_compression_time", "peak_sprocket_torque", "peak_idler_force", "peak_sinkage",
+          "mean_drawbar_pull", "mean_slip")
 
 
 def _wheels(study):
