@@ -614,3 +614,18 @@ def test_plotting_a_file_that_is_not_a_run_says_so_in_one_line(tmp_path):
     xr.Dataset({"a": ("x", [1.0, 2.0])}).to_netcdf(tmp_path / "other.nc")
     with pytest.raises(ValueError, match=r"other.nc is a netCDF file but not a trackbench run"):
         plot_run(tmp_path / "other.nc", tmp_path / "p")
+
+
+def test_a_soil_study_figure_has_panels_for_sinkage_pull_and_slip():
+    """Each in its own unit (the soft_soil study's question: drawbar pull and sinkage); a
+    rigid-ground study keeps the two force panels."""
+    import pandas as pd
+    from trackbench.replay.study_figures import _panels
+    df = pd.DataFrame({"peak_wheel1_force_y": [1e5], "peak_ground_force_y": [3e5], "peak_sinkage": [0.06],
+                       "mean_drawbar_pull": [1.8e3], "mean_slip": [0.013]})
+    panels = {label: (cols, scale) for label, cols, scale in _panels(df)}
+    assert panels["deepest sinkage into the soil (cm)"] == (["peak_sinkage"], 1e-2)
+    assert panels["mean drawbar pull, 2nd half (kN)"] == (["mean_drawbar_pull"], 1e3)
+    assert panels["mean slip (sprocket), 2nd half (%)"] == (["mean_slip"], 1e-2)
+    assert panels["peak force (kN)"][0] == ["peak_ground_force_y"]      # the mean pull not among peaks
+    assert len(_panels(df.drop(columns=["peak_sinkage", "mean_drawbar_pull", "mean_slip"]))) == 2

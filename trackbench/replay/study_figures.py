@@ -121,11 +121,11 @@ def _x_of(df, axis, src):
     return col, False, col.map(where).astype(float).to_numpy(), np.arange(len(raw), dtype=float), raw
 
 
-def _draw_panel(ax, df, cols, groups, x_all, order, completed):
+def _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed):
     """Each column's runs as points and, per group, the line through the medians at each x;
     failed runs as red crosses on the axis."""
     for k, c in enumerate(cols):
-        y = df[c].astype(float).to_numpy() / 1e3
+        y = df[c].astype(float).to_numpy() / per_unit
         label = f"wheel {_wheel_of(c)}" if _wheel_of(c) is not None else c.replace("peak_", "peak ").replace("_", " ")
         for gi, (glabel, mask) in enumerate(groups):
             ls, marker = _STYLES[gi % len(_STYLES)] if glabel else ("-", "o")
@@ -178,10 +178,10 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
     others = [a for a in present if a not in tied]
     groups, too_many = _groups(df, others, np.where(completed, x_all, np.nan))
     grouped = bool(groups[0][0])
-    fig, axs = plt.subplots(len(panels), 1, figsize=(10 if grouped else 8, 3.4 * len(panels) + 0.7),
+    fig, axs = plt.subplots(len(panels), 1, figsize=(10 if grouped else 8, (3.4 if len(panels) < 3 else 2.6) * len(panels) + 0.7),
                             sharex=True, squeeze=False, layout="constrained")
-    for ax, (ylabel, cols) in zip(axs[:, 0], panels):
-        _draw_panel(ax, df, cols, groups, x_all, order, completed)
+    for ax, (ylabel, cols, per_unit) in zip(axs[:, 0], panels):
+        _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed)
         ax.set_ylabel(ylabel)
         _legend(ax, groups, plt)
     if not numeric:
@@ -190,9 +190,26 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
         axs[-1, 0].set_xticks(range(len(raw)), labels, rotation=25 if tilt else 0, ha="right" if tilt else "center")
     axs[-1, 0].set_xlabel(axis_label(axis, col.dropna().to_numpy() if numeric else ()))
     note = _note(axis, others, tied, grouped, too_many, np.isfinite(x_all).sum() > len(order))
-    fig.suptitle(_wrap(f"study {src.parent.name}: peak forces against {axis}{note}", 110 if grouped else 85),
+    what = "peak forces" if len(panels) <= 2 else "peak forces, sinkage, drawbar pull and slip"
+    fig.suptitle(_wrap(f"study {src.parent.name}: {what} against {axis}{note}", 110 if grouped else 85),
                  fontsize=10)
     return fig
+
+
+def _panels(df):
+    """(y label, summary columns, SI value of one display unit) of each panel: the wheels' peak
+    forces, the other peak forces, and on soft soil the deepest sinkage, the mean drawbar pull
+    and the mean slip, each alone (their own units)."""
+    from ..quantities import BY_NAME, PEAKS
+    forces = [q.name for q in PEAKS if q.unit == "kN" and q.kind == "peak" and not q.per_wheel and q.name in df.columns]
+    panels = [("peak vertical wheel-track force (kN)", _wheel_columns(df), 1e3)]
+    if forces:
+        panels.append(("peak force (kN)", forces, 1e3))
+    for name in ("peak_sinkage", "mean_drawbar_pull", "mean_slip"):
+        if name in df.columns and df[name].notna().any():
+            q = BY_NAME[name]
+            panels.append((f"{q.label} ({q.unit})", [name], q.per_unit))
+    return panels
 
 
 def plot_study(study_dir, out_dir):
@@ -209,11 +226,7 @@ def plot_study(study_dir, out_dir):
         raise ValueError(f"{src}: no parameter varies between the runs; nothing to plot against")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    from ..quantities import PEAKS
-    other_cols = [q.name for q in PEAKS if q.unit == "kN" and not q.per_wheel and q.name in df.columns]
-    panels = [("peak vertical wheel-track force (kN)", _wheel_columns(df))]
-    if other_cols:
-        panels.append(("peak force (kN)", other_cols))
+    panels = _panels(df)
     completed = (df["status"] == "completed").to_numpy() if "status" in df.columns else np.ones(len(df), bool)
     paths = []
     for axis in axes:
