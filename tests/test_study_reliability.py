@@ -397,6 +397,17 @@ def test_reasons_for_permission_and_missing_paths():
     assert r == f"read-only file system: /data/s (host {host})"
 
 
+def test_permission_denied_on_a_full_disk_is_the_full_disk(tmp_path):
+    """HDF5 creating a file on a full tmpfs came back as EACCES: in a folder the worker may
+    write to, with less room than the run needs, the reason is the disk."""
+    exc = PermissionError(errno.EACCES, "Permission denied", str(tmp_path / ".timeseries.nc.x.tmp"))
+    free = executors._free_bytes(tmp_path)
+    assert executors.failure_reason(exc, tmp_path, need_bytes=free + 2**30).startswith(
+        f"no space left on the device holding {tmp_path}")
+    assert executors.failure_reason(exc, tmp_path, need_bytes=1000).startswith("permission denied: ")
+    assert executors.failure_reason(exc, tmp_path).startswith("permission denied: ")
+
+
 @needs_unshare
 def test_real_full_disk_then_rerun_with_space(tmp_path):
     """A 0.8 MB file system for 4 runs of about 0.32 MB each: the runs that do not fit fail

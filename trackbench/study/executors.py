@@ -114,15 +114,18 @@ def failure_reason(exc, folder, need_bytes=None):
     host = socket.gethostname()
     err = getattr(exc, "errno", None)
     where = os.fsdecode(getattr(exc, "filename", None) or folder)
-    if err in (errno.EACCES, errno.EPERM):
+    free = _free_bytes(folder)
+    full = need_bytes is not None and free is not None and free < need_bytes + 2**20
+    # HDF5 creating a file on a full disk can come back as "permission denied": in a folder
+    # this process may write to, with no room for the run, the disk is what is wrong
+    denied = err in (errno.EACCES, errno.EPERM) and not (full and os.access(folder, os.W_OK | os.X_OK))
+    if denied:
         return f"permission denied: {where} (host {host}, uid {os.getuid()})"
     if err == errno.EROFS:
         return f"read-only file system: {where} (host {host})"
     if err == errno.ENOENT:
         return f"{where} does not exist on host {host}"
-    free = _free_bytes(folder)
-    if err in (errno.ENOSPC, errno.EDQUOT) or (
-            (err is None or err < 0) and need_bytes is not None and free is not None and free < need_bytes + 2**20):
+    if err in (errno.ENOSPC, errno.EDQUOT, errno.EACCES, errno.EPERM) or ((err is None or err < 0) and full):
         size = f", the run writes about {need_bytes / 1e6:.2f} MB" if need_bytes else ""
         room = "free space unknown" if free is None else f"{free / 1e6:.2f} MB free"
         return f"no space left on the device holding {folder} (host {host}): {room}{size}"
