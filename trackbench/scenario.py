@@ -148,6 +148,28 @@ RULES = {
     "record.enabled": (bool, None, None, "true or false"),
     "record.every": (int, 1, 10**6, "an integer >= 1"),
 }
+# The unit of every parameter that has one (axis labels and titles of the figures).
+UNITS = {"speed": "m/s", "duration": "s", "gravity": "m/s^2", "output_interval": "s", "perturbation": "m",
+         "vehicle.chassis_mass": "kg", "vehicle.chassis_inertia": "kg m^2", "vehicle.arm_mass": "kg",
+         "vehicle.arm_inertia": "kg m^2", "vehicle.arm_length": "m", "vehicle.arm_angle": "deg",
+         "vehicle.torsion_stiffness": "N m/rad", "vehicle.wheel_radius": "m", "vehicle.first_pivot_x": "m",
+         "vehicle.pivot_y": "m", "vehicle.pivot_spacing": "m", "vehicle.front_track_end": "m",
+         "vehicle.rear_track_end": "m", "track.link_length": "m", "track.pin_mass": "kg",
+         "track.link_stiffness": "N/m", "track.pad_wheel": "m", "track.pad_ground": "m",
+         "track.wheel_stiffness": "N/m", "track.ground_stiffness": "N/m", "track.link_damping": "N s/m",
+         "vehicle.arm_damping": "N m s/rad", "contact.damping_ramp": "m", "contact.min_approach_speed": "m/s",
+         "contact.friction_velocity": "m/s", "contact.friction_stiffness": "N/m", "track.tension": "N",
+         "track.width": "m", "sprocket.pitch_radius": "m", "sprocket.seat_radius": "m",
+         "sprocket.pin_radius": "m", "sprocket.tip_radius": "m", "sprocket.flank_angle": "deg",
+         "sprocket.stiffness": "N/m", "sprocket.inertia": "kg m^2", "idler.radius": "m",
+         "idler.mass": "kg", "idler.preload": "N", "idler.stiffness": "N/m", "idler.damping": "N s/m",
+         "idler.travel": "m", "idler.guide_angle": "deg", "rollers.positions": "m", "rollers.radius": "m",
+         "drive.torque": "N m", "drive.target": "m/s", "drive.gain_p": "N m s/m", "drive.gain_i": "N m/m",
+         "drive.torque_limit": "N m", "drawbar.load": "N", "drawbar.hitch": "m",
+         "drawbar.rig_damping": "N s/m", "lee.position_tol": "m", "lee.matrix_update_angle": "rad",
+         "terrain.height": "m", "terrain.length": "m", "terrain.position": "m",
+         "terrain.first_contact_time": "s", "terrain.gap": "m"}
+
 _OPEN_LOW = {"duration", "drawbar.rig_damping", "tolerance", "output_interval", "vehicle.arm_angle", "contact.exponent", "track.width",
              "contact.restitution", "contact.damping_ramp", "contact.min_approach_speed",
              "contact.friction_velocity", "contact.friction_stiffness"} | {

@@ -386,16 +386,18 @@ def wheel_contacts(w, m, diag, mem):
 
 
 @njit(**INLINE)
-def _ground_traction(b, apos, avel, t, p, par, soil, gripped):
+def _ground_traction(b, apos, avel, t, p, par, soil, law, gripped):
     """The tangential force along the ground's unit tangent t on pin b pressed with p:
     (force, its dissipated power, the mu left for the regularised Coulomb law of _push_pin,
-    gripped). On soft soil Janosi-Hanamoto's shear replaces friction; with the bristle law
-    the pin's first ground contact holds its bristle (later ones, at a concave corner, keep
-    the regularised law); otherwise the regularised law alone."""
-    rut, touchdown, sink, grip = soil
-    if par[P_SOIL] != 0.0:
+    gripped). law = (on soft soil, bristle law), decided once per call of _pins_on_ground.
+    On soft soil Janosi-Hanamoto's shear replaces friction; with the bristle law the pin's
+    first ground contact holds its bristle (later ones, at a concave corner, keep the
+    regularised law); otherwise the regularised law alone."""
+    _, touchdown, _, grip = soil
+    on_soil, bristle = law
+    if on_soil:
         return soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], t, p, par), 0.0, 0.0, gripped
-    if uses_bristle(par) and not gripped:
+    if bristle and not gripped:
         ft, fd = pin_grip(b, apos, avel, t, p, par, touchdown, grip)
         return ft, fd, 0.0, True
     return 0.0, 0.0, par[P_FRICTION], gripped
@@ -458,7 +460,8 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
             else:
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)     # Eq. (6)
-            ft, fd, mu_left, gripped = _ground_traction(b, apos, avel, (ny, -nx), p, par, soil, gripped)
+            ft, fd, mu_left, gripped = _ground_traction(b, apos, avel, (ny, -nx), p, par, soil, (on_soil, bristle),
+                                                        gripped)
             fx, fy = p * nx + ft * ny, p * ny - ft * nx
             if on_soil:     # what the soil takes counts as dissipated (its elastic rebound gives some back)
                 pd = -(fx * avel[b, 0] + fy * avel[b, 1])

@@ -3,7 +3,6 @@ the words and units of parameters and values (axis labels, run titles). matplotl
 optional dependency (extra "plot"); it is imported only when a figure is drawn."""
 
 import json
-import re
 import textwrap
 from pathlib import Path
 
@@ -81,38 +80,10 @@ def _wrap(text, width=95):
 
 # ------------------------------------------------------------ parameters and their units ----
 
-# units of parameters whose rule text (trackbench/scenario.py) names none
-_UNITS = {"output_interval": "s", "vehicle.chassis_mass": "kg", "vehicle.chassis_inertia": "kg m^2",
-          "vehicle.arm_mass": "kg", "vehicle.arm_inertia": "kg m^2", "vehicle.arm_length": "m",
-          "vehicle.torsion_stiffness": "N m/rad", "vehicle.wheel_radius": "m", "vehicle.pivot_spacing": "m",
-          "track.link_length": "m", "track.pin_mass": "kg", "track.link_stiffness": "N/m", "track.pad_wheel": "m",
-          "track.pad_ground": "m", "track.wheel_stiffness": "N/m", "track.ground_stiffness": "N/m",
-          "sprocket.seat_radius": "m", "sprocket.pin_radius": "m", "sprocket.stiffness": "N m/rad",
-          "sprocket.inertia": "kg m^2", "idler.radius": "m", "idler.mass": "kg", "idler.stiffness": "N/m",
-          "idler.damping": "N s/m", "idler.travel": "m", "rollers.radius": "m", "drive.gain_p": "N m s/rad",
-          "drive.gain_i": "N m/rad", "drive.torque_limit": "N m", "terrain.gap": "m"}
-_UNIT_PARTS = {"m", "s", "N", "kg", "deg", "rad", "Pa", "kPa", "2", "3"}
-
-
-def _is_unit(text):
-    parts = [x for x in re.split(r"[ /^]", text.strip()) if x]
-    return bool(parts) and all(x in _UNIT_PARTS for x in parts)
-
-
 def parameter_unit(name):
-    """The unit of a scenario parameter ('' when it has none): from its rule's text in
-    trackbench/scenario.py ("a number in [0, 100] m/s", "(N; 0: derived ...)"), else from a
-    table of the parameters whose rule text names none."""
-    from ..scenario import RULES, TERRAIN_RULES
-    rule = RULES.get(name) or (TERRAIN_RULES.get(name[len("terrain."):]) if name.startswith("terrain.") else None)
-    text = rule[3] if rule else ""
-    m = re.search(r"[\])]\s+([^(;:]+?)\s*(?:\(|$)", text)
-    if m and _is_unit(m.group(1)):
-        return m.group(1).strip()
-    for m in re.finditer(r"\(([^;:,()]+)[;:,)]", text):
-        if _is_unit(m.group(1)):
-            return m.group(1).strip()
-    return _UNITS.get(name, "")
+    """The unit of a scenario parameter ('' when it has none): scenario.UNITS."""
+    from ..scenario import UNITS
+    return UNITS.get(name, "")
 
 
 def display_scale(name, values=()):
@@ -187,9 +158,9 @@ def run_label(ds, path=None):
     name = _name(ds)
     if path is None:
         return name
-    try:
-        rec = json.loads((find_timeseries(path).parent / "run.json").read_text())
-    except (OSError, ValueError):
+    from ..study.store import read_json
+    rec = read_json(find_timeseries(path).parent / "run.json")
+    if not isinstance(rec, dict):
         return name
     text = f"{rec.get('study', name)} run {str(rec.get('run_id', ''))[:8]}".rstrip()
     params = rec.get("params") or {}

@@ -55,10 +55,8 @@ _STYLES = [("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1, 1
 
 def _run_scenarios(src):
     """run id -> resolved scenario, from the study's runs.json ({} without one)."""
-    try:
-        runs = json.loads((src.parent / "runs.json").read_text())["runs"]
-    except (OSError, ValueError, KeyError, TypeError):
-        return {}
+    from ..study.store import read_json
+    runs = (read_json(src.parent / "runs.json") or {}).get("runs") or []
     return {str(r.get("run_id")): r.get("scenario") or {} for r in runs}
 
 

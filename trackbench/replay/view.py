@@ -8,7 +8,6 @@ folder or its TOML file) together with a run id (a unique prefix is enough).
 import os
 import subprocess
 import sys
-import tomllib
 from pathlib import Path
 
 from .record import RECORDING_NAME
@@ -19,23 +18,14 @@ class ViewError(RuntimeError):
 
 
 def study_output(toml_path):
-    """The results folder a study TOML writes to ([study] output, default results/<name>)."""
-    toml_path = Path(toml_path)
+    """The results folder of a study TOML, found as `study run` puts it (study.summary.study_folder);
+    ValueError (one line) when the file is bad or its results do not exist."""
+    from ..study.spec import StudyError
+    from ..study.summary import study_folder
     try:
-        from ..study.spec import load_study
-    except ImportError:
-        load_study = None
-    if load_study is not None:
-        try:
-            return Path(load_study(toml_path).output)
-        except Exception as e:  # the study layer's own error, one line
-            raise ValueError(f"{toml_path}: {e}") from e
-    try:
-        doc = tomllib.loads(toml_path.read_text())
-    except (OSError, tomllib.TOMLDecodeError) as e:
-        raise ValueError(f"{toml_path}: {e}") from e
-    meta = doc.get("study", {})
-    return Path(meta.get("output", f"results/{meta.get('name', toml_path.stem)}"))
+        return study_folder(toml_path)[1]
+    except StudyError as e:
+        raise ValueError(str(e)) from None
 
 
 def _run_folder(study_dir, run_id):

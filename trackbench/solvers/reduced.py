@@ -181,6 +181,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     h = min(ctl.h0, h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
+    memory = has_ground_memory(m.par)   # soil or bristles: their memories move after each accepted step
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
@@ -213,7 +214,6 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
-        memory = has_ground_memory(m.par)
         if memory:
             _keep_end(w, lw.end)
         n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
