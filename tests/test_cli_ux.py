@@ -214,3 +214,12 @@ def test_version_and_help_shows_flags_and_choices():
         assert re.search(r"--storage\s+full\|compact", text)
     assert re.search(r"--executor\s+local\|dask", study_help)
     assert "[study] storage" in study_help and "[study] output" in study_help   # not eaten as markup
+
+
+def test_params_lists_each_unit_in_its_own_column():
+    from trackbench.runner import parameter_table
+    table = parameter_table().splitlines()
+    assert table[0].split() == ["name", "paper", "value", "unit", "allowed"]
+    rows = {r.split()[0]: r for r in table[1:] if r.strip()}
+    assert rows["drive.gain_p"].split()[1:5] == ["30000.0", "N", "m", "s/m"]
+    assert rows["track.link_stiffness"].split()[2] == "N/m"

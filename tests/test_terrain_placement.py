@@ -1,6 +1,7 @@
 """A placement key given by the user replaces the default's: the paper's step is placed
 by first_contact_time, and a user who gives position (or gap) means that instead."""
 
+import numpy as np
 import pytest
 
 import trackbench as tb
@@ -55,3 +56,28 @@ def test_placement_by_time_needs_a_speed():
 def test_one_road_wheel_is_not_a_vehicle():
     with pytest.raises(ScenarioError, match=r"vehicle.n_wheels = 1 is not allowed: expected an integer in \[2, 20\]"):
         tb.Scenario.paper(**{"vehicle.n_wheels": 1})
+
+
+def test_a_polyline_that_runs_straight_through_a_point_is_one_segment():
+    """A points terrain whose flat ground is given in pieces (the resting track on x < 0
+    and x > 0): one segment, so that the ground the vehicle starts on is not taken for an
+    obstacle (first contact was reported at t = 0)."""
+    from trackbench.model.terrain import ground_from_points
+    pts = [[0.0, 0.0], [3.0, 0.0], [3.5, 0.1], [4.0, 0.2], [5.0, 0.2]]
+    merged = ground_from_points(pts, merge_straight=True)
+    assert merged.vertices[:, 0].tolist() == [-1000.0, 3.0, 4.0, 1000.0]
+    assert len(ground_from_points(pts).segments) == 6     # the other terrains keep their vertices
+
+
+def test_a_points_terrain_starts_without_obstacle_contact():
+    ds = tb.simulate(tb.Scenario.paper(duration=0.01, output_interval=1e-3,
+                                       terrain={"kind": "points", "points": [[0.0, 0.0], [3.0, 0.0], [3.5, 0.1]]}))
+    assert ds.attrs["status"] == "completed"
+    assert np.isnan(float(ds.first_contact_time))
+
+
+def test_a_run_that_ends_before_the_planned_contact_says_so():
+    from trackbench.runner import format_summary
+    ds = tb.simulate(tb.Scenario.paper(duration=0.01, output_interval=1e-3))
+    line = next(x for x in format_summary(ds).splitlines() if "first obstacle contact" in x)
+    assert "none (placed to be met at 0.0568 s, after the run's end at 0.01 s)" in line

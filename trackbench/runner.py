@@ -7,7 +7,7 @@ from pathlib import Path
 from .model.soil import SOIL_CHOICES
 from .presets import PRESETS, preset_values
 from .quantities import accounted_balance
-from .scenario import RULES, Scenario, ScenarioError, flatten, paper_step
+from .scenario import RULES, UNITS, Scenario, ScenarioError, flatten, paper_step
 
 
 def parse_assignment(text):
@@ -32,6 +32,17 @@ def scenario_from_sets(sets, duration=None):
 
 def _time(t, digits):
     return "none" if t != t else f"{t:.{digits}f} s"
+
+
+def _unmet(ds, contact):
+    """Why no obstacle was met where the first one was placed by time after the run's end."""
+    import json
+    terrain = json.loads(ds.attrs["scenario"])["terrain"]
+    first = (terrain.get("obstacles") or [terrain])[0]
+    planned = first.get("first_contact_time")
+    if contact == contact or planned is None or planned <= ds.attrs["t_final"]:
+        return ""
+    return f" (placed to be met at {planned:g} s, after the run's end at {ds.attrs['t_final']:g} s)"
 
 
 def _energy_line(ds, s):
@@ -73,8 +84,8 @@ def format_summary(ds, path=None):
         line(tension.label, f"{shown(tension.name):10.1f} {tension.unit}"),
         line("chassis vertical acceleration", f"{shown('min_chassis_ay'):+.2f} .. {shown(ay.name):+.2f} {ay.unit}"),
         line(vx.label, f"{shown(vx.name):.4f} {vx.unit}"),
-        line(contact.label, f"{_time(shown(contact.name), 5)}; {compression.label} "
-                            f"{_time(shown(compression.name), 4)}"),
+        line(contact.label, f"{_time(shown(contact.name), 5)}{_unmet(ds, shown(contact.name))}; "
+                            f"{compression.label} {_time(shown(compression.name), 4)}"),
     ]
     # the closed track's and the soil's own (sprocket torque, tensioner force, sinkage, pull, slip)
     lines += [line(x.label, f"{shown(x.name):10.2f} {x.unit}") for x in SUMMARY if x.needs and x.variable in ds]
@@ -155,13 +166,16 @@ def run_one(sets, duration, out, name=None, force=False, storage="full"):
 
 def parameter_table():
     base = flatten({k: v for k, v in paper_step().items() if k != "terrain"})
-    rows = [f"{'name':32s} {'paper value':>16s}  allowed"]
+    rows = [f"{'name':32s} {'paper value':>16s}  {'unit':9s} allowed"]
+
+    def row(name, value, allowed):
+        return f"{name:32s} {value:>16s}  {UNITS.get(name, ''):9s} {allowed}"
+
     for k, rule in RULES.items():
-        rows.append(f"{k:32s} {str(base.get(k, '')):>16s}  {rule[3]}")
-    rows.append("terrain.kind                     step              flat, step, ramp, block, bump, points, sequence")
+        rows.append(row(k, str(base.get(k, "")), rule[3]))
+    rows.append(row("terrain.kind", "step", "flat, step, ramp, block, bump, points, sequence"))
     rows.append("terrain.height / length / position / first_contact_time / gap / points / obstacles: see README")
-    rows.append("terrain.soil                     rigid             rigid, " + ", ".join(SOIL_CHOICES[1:])
-                + ", or a table (docs/usage.md)")
+    rows.append(row("terrain.soil", "rigid", "rigid, " + ", ".join(SOIL_CHOICES[1:]) + ", or a table (docs/usage.md)"))
     for name in PRESETS:
         if name == "paper":
             continue

@@ -16,8 +16,21 @@ class Ground:
     corners: np.ndarray    # (m, 2) convex corners
 
 
-def ground_from_points(points):
-    """Build a Ground from interior points; extends the ends horizontally to +-FAR."""
+def _straight_through(verts):
+    """Vertices without those the polyline runs straight through: a user's polyline that
+    starts its flat ground at x = 0 would otherwise put the resting track on two segments,
+    and the second counts as an obstacle (its first contact reported at t = 0)."""
+    d = np.diff(verts, axis=0)
+    cross = d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]
+    dot = d[:-1, 0] * d[1:, 0] + d[:-1, 1] * d[1:, 1]
+    keep = np.ones(len(verts), bool)
+    keep[1:-1] = ~((cross == 0.0) & (dot > 0.0))
+    return verts[keep]
+
+
+def ground_from_points(points, merge_straight=False):
+    """Build a Ground from interior points; extends the ends horizontally to +-FAR;
+    merge_straight: one segment where consecutive ones run on in the same direction."""
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     left = [-FAR, pts[0, 1]] if pts[0, 0] > -FAR else None
     right = [FAR, pts[-1, 1]] if pts[-1, 0] < FAR else None
@@ -26,6 +39,8 @@ def ground_from_points(points):
     keep = np.ones(len(verts), bool)
     keep[1:] = np.any(np.diff(verts, axis=0) != 0.0, axis=1)
     verts = verts[keep]
+    if merge_straight:
+        verts = _straight_through(verts)
     d = np.diff(verts, axis=0)
     length = np.hypot(d[:, 0], d[:, 1])
     t = d / length[:, None]
@@ -102,7 +117,7 @@ def build_ground(scenario, eq):
     if t["kind"] == "flat":
         return ground_from_points([[-FAR, 0.0], [FAR, 0.0]]), {}
     if t["kind"] == "points":
-        return ground_from_points(t["points"]), {}
+        return ground_from_points(t["points"], merge_straight=True), {}
     obstacles = t["obstacles"] if t["kind"] == "sequence" else [t]
     pts = [[-FAR, 0.0]]
     level = 0.0
