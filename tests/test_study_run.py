@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -301,6 +302,39 @@ def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     p.close()
     out = term.getvalue()
     assert "\x1b" in out and "done 1  failed 0  running 2  of 3" in out and "ETA" in out and "[1/3]" not in out
+
+
+def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
+    """The fork server compiles the study's model once for all workers and says so in a flag
+    file: a terminal's bar shows it while it lasts, a log says how long the first run waited,
+    and the ETA does not count that wait once per run."""
+    import io
+    import json
+    from trackbench.study.runner import _Progress
+    flag = tmp_path / "flag.json"
+    flag.write_text(json.dumps({"compiling": True, "seconds": 0.0}))
+    term = io.StringIO()
+    p = _Progress(3, 0, stream=term, workers=2, terminal=True, flag=flag)
+    p.bar.refresh()
+    assert "compiling the model" in re.sub(r"\x1b\[[0-9;?]*[a-zA-Z]", "", term.getvalue())
+    p.close()
+    flag.write_text(json.dumps({"compiling": False, "seconds": 3600.0}))
+    log = io.StringIO()
+    p = _Progress(3, 0, stream=log, workers=2, flag=flag)
+    p.update({"run_id": "a1", "status": "completed"})
+    lines = log.getvalue().splitlines()
+    assert lines[1].startswith("(the workers waited 3600 s for the model to compile")
+    assert lines[2].endswith("ETA 0 s)")     # not 7200 s: the hour of compiling is not per run
+
+
+def test_one_warm_scenario_per_kind_of_compiled_model():
+    from trackbench.study.executors import warm_kinds
+    paper = tb.Scenario.paper().to_dict()
+    runs = [paper, {**paper, "speed": 5.0}, tb.Scenario.paper(**{"terrain.soil": "lete_sand"}).to_dict(),
+            tb.Scenario.paper(**{"track.layout": "closed"}).to_dict(), tb.Scenario.paper(method="dop853").to_dict()]
+    kinds = warm_kinds(runs)
+    assert [(k["track"]["layout"], k["method"]) for k in kinds] == [("paper", "dopri5"), ("closed", "dopri5"),
+                                                                    ("paper", "dop853")]
 
 
 def test_workers_are_forks_of_a_single_threaded_preloaded_server():

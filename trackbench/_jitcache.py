@@ -69,8 +69,17 @@ class CompileNotice:
     machine, or after an upgrade, compiles for about a minute with nothing else to show.
     ``seconds`` is the time spent compiling (nested compilations counted once)."""
 
-    def __init__(self, stream):
-        self.stream, self.seconds, self._depth, self._t0 = stream, 0.0, 0, 0.0
+    def __init__(self, stream, flag=None):
+        self.stream, self.flag, self.seconds, self._depth, self._t0 = stream, flag, 0.0, 0, 0.0
+
+    def _tell(self, compiling):
+        """The flag file (a study's fork server compiles for its workers: the command shows it)."""
+        if self.flag:
+            import json
+            try:
+                Path(self.flag).write_text(json.dumps({"compiling": compiling, "seconds": self.seconds}))
+            except OSError:
+                pass
 
     def __enter__(self):
         from numba.core import event
@@ -80,17 +89,19 @@ class CompileNotice:
         class _Listener(event.Listener):
             def on_start(self, ev):
                 if notice._depth == 0:
-                    if notice.seconds == 0.0:
+                    if notice.seconds == 0.0 and notice.stream is not None:
                         print("compiling the model for this kind of run (first use on this machine or after an "
                               "upgrade: about a minute; later runs load it from the cache) ...",
                               file=notice.stream, flush=True)
                     notice._t0 = time.perf_counter()
+                    notice._tell(True)
                 notice._depth += 1
 
             def on_end(self, ev):
                 notice._depth -= 1
                 if notice._depth == 0:
                     notice.seconds += max(time.perf_counter() - notice._t0, 1e-9)
+                    notice._tell(False)
 
         self._listener = _Listener()
         event.register("numba:compile", self._listener)

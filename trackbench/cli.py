@@ -99,7 +99,7 @@ def study_run(
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
     study = _load_study_or_fail(file, output)   # a bad study file fails here, before the solver libraries load
-    from .study.executors import check_arguments, start_workers
+    from .study.executors import check_arguments, start_workers, warm_kinds
     from .study.runner import check_output
     try:
         check_arguments(workers, executor, scheduler, storage)
@@ -107,8 +107,9 @@ def study_run(
     except ValueError as e:
         _fail(str(e))
     from .study import store
-    if force or not all(store.is_completed(study.output, r.run_id) for r in study.runs):
-        start_workers(executor, scheduler)   # the workers load while this process imports and sets up
+    todo = [r for r in study.runs if force or not store.is_completed(study.output, r.run_id)]
+    if todo:   # the workers load (or compile) the study's models while this process imports and sets up
+        start_workers(executor, scheduler, warm=warm_kinds(r.scenario for r in todo))
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:

@@ -275,9 +275,34 @@ def _context():
     return ctx
 
 
-def start_workers(executor="local", scheduler=None):
+WARM = "TRACKBENCH_WARM"    # what the fork server's preload warms: JSON {"scenarios": [...], "flag": path}
+MAX_WARM = 4
+
+
+def warm_kinds(scenarios):
+    """One scenario dict of each kind of compiled model among a study's runs (solver, track
+    layout and method each compile their own time loop; the soil, friction and contact
+    options are flags inside it), at most MAX_WARM."""
+    kinds = {}
+    for d in scenarios:
+        kinds.setdefault((d.get("solver"), d.get("track", {}).get("layout"), d.get("method")), d)
+    return list(kinds.values())[:MAX_WARM]
+
+
+def compile_flag():
+    """The file where this command's fork server says that it compiles (the progress shows it)."""
+    import tempfile
+    return Path(tempfile.gettempdir()) / f"trackbench-compiling-{os.getpid()}.json"
+
+
+def start_workers(executor="local", scheduler=None, warm=None):
     """Start the fork server now (it loads in its own process while the command does its own
-    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler."""
+    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
+    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
+    in compile_flag()) before it forks a worker; default: the paper's."""
+    if warm:
+        import json
+        os.environ[WARM] = json.dumps({"scenarios": warm, "flag": str(compile_flag())})
     # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
     # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
     # pyarrow: the fork server and the workers inherit this, and so the server has a single

@@ -55,11 +55,46 @@ def warm():
     from trackbench.study import executors
 
     _orphaned()
-    ds = trackbench.simulate(trackbench.Scenario.paper(duration=1e-3, output_interval=1e-3))
+    ds = None
+    for sc in _kinds():
+        _orphaned()
+        ds = _load(sc) or ds
     _orphaned()
+    if ds is None:
+        return
     executors.run_summary(ds)
     with tempfile.TemporaryDirectory() as tmp:
         write_netcdf(ds, Path(tmp) / "warm.nc")
+
+
+def _kinds():
+    """The scenarios to warm: the study's kinds of model (executors.WARM), else the paper's."""
+    import json
+
+    import trackbench
+    from trackbench.study import executors
+    spec = json.loads(os.environ.get(executors.WARM) or "{}")
+    short = {"duration": 1e-3, "output_interval": 1e-3}
+    kinds = spec.get("scenarios") or [None]
+    for d in kinds:
+        try:
+            sc = trackbench.Scenario.paper(**short) if d is None else trackbench.Scenario.from_dict({**d, **short})
+        except Exception:  # noqa: BLE001  (the real run reports it)
+            continue
+        yield sc, spec.get("flag")
+
+
+def _load(kind):
+    """A 1 ms run of the scenario: its compiled model loaded from the cache, or compiled once
+    here for every worker (saying so in the flag file, which the command's progress shows)."""
+    import trackbench
+    from trackbench._jitcache import CompileNotice
+    sc, flag = kind
+    try:
+        with CompileNotice(None, flag=flag):
+            return trackbench.simulate(sc)
+    except Exception:  # noqa: BLE001
+        return None
 
 
 def warm_recording():

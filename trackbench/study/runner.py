@@ -128,18 +128,17 @@ class _Progress:
     """A live rich progress bar on a terminal (done, failed, running, elapsed, ETA); one plain
     line per finished run otherwise (a log, a pipe, CI)."""
 
-    def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None):
+    def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None, flag=None):
         from rich.console import Console
         self.console = Console(file=stream or sys.stderr, force_terminal=terminal)
         self.console.soft_wrap = not self.console.is_terminal   # a log keeps one line per run, however long
         self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
-        self.quiet, self.t0 = quiet, time.perf_counter()
+        self.quiet, self.t0, self.flag, self.compiled = quiet, time.perf_counter(), flag, 0.0
         self.bar = None
         if not quiet and self.console.is_terminal and total:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
-            self.bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(),
-                                TextColumn("{task.fields[counts]}"), TimeElapsedColumn(),
-                                TextColumn("ETA"), TimeRemainingColumn(), console=self.console)
+            self.bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), _counts_column(self),
+                                TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=self.console)
             self.task = self.bar.add_task("runs", total=total, counts=self._counts())
             self.bar.start()
         elif not quiet:
@@ -158,6 +157,16 @@ class _Progress:
         if self.bar is not None:
             self.bar.update(self.task, counts=self._counts())
 
+    def compiling(self):
+        """(compiling now, seconds compiled so far) from the fork server's flag file."""
+        import json
+        try:
+            said = json.loads(self.flag.read_text())
+        except (OSError, ValueError, AttributeError):
+            return False, self.compiled
+        self.compiled = max(self.compiled, float(said.get("seconds", 0.0)))
+        return bool(said.get("compiling")), self.compiled
+
     def update(self, rec):
         if rec["status"] == "completed":
             self.done += 1
@@ -167,7 +176,11 @@ class _Progress:
             self.bar.update(self.task, advance=1, counts=self._counts())
         elif not self.quiet:
             n = self.done + self.failed
-            el = time.perf_counter() - self.t0
+            _, compiled = self.compiling()
+            if n == 1 and compiled > 0.0:
+                self.console.print(f"(the workers waited {compiled:.0f} s for the model to compile: once per "
+                                   "machine and version; later studies load it from the cache)", highlight=False)
+            el = max(time.perf_counter() - self.t0 - compiled, 0.0)   # the compiling is not what every run takes
             eta = el / n * (self.total - n)
             msg = "" if rec["status"] == "completed" else f": {rec.get('status_message', '')}"
             self.console.print(f"[{n}/{self.total}] {rec['run_id']} {rec['status']}{msg}  ({self._counts()}, "
@@ -180,6 +193,21 @@ class _Progress:
     def close(self):
         if self.bar is not None:
             self.bar.stop()
+
+
+def _counts_column(progress):
+    """The bar's counts; while the fork server compiles the model, that instead (the workers
+    wait for it: "running" would say otherwise)."""
+    from rich.progress import TextColumn
+    from rich.text import Text
+
+    class Counts(TextColumn):
+        def render(self, task):
+            if progress.compiling()[0]:
+                return Text("compiling the model (once, 1-2 min)", style="yellow")
+            return super().render(task)
+
+    return Counts("{task.fields[counts]}")
 
 
 def run_study(path, workers=2, executor="local", scheduler=None, force=False, output=None,
@@ -197,10 +225,10 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
-        if tasks:
-            executors.start_workers(executor, scheduler)   # they load while this process sets up
+        if tasks:   # they load while this process sets up
+            executors.start_workers(executor, scheduler, warm=executors.warm_kinds(t["scenario"] for t in tasks))
         out.skipped = len(done)
-        progress = _Progress(len(tasks), len(done), quiet, workers=workers)
+        progress = _Progress(len(tasks), len(done), quiet, workers=workers, flag=executors.compile_flag())
         if executor == "dask":
             stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
         else:
@@ -216,6 +244,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         finally:
             stream.close()
             progress.close()
+            executors.compile_flag().unlink(missing_ok=True)
             store.clean_tmp(study.output)  # what killed workers left half-written
             _summarise(study, out)
     out.elapsed = time.perf_counter() - t0
