@@ -223,3 +223,16 @@ def test_params_lists_each_unit_in_its_own_column():
     rows = {r.split()[0]: r for r in table[1:] if r.strip()}
     assert rows["drive.gain_p"].split()[1:5] == ["30000.0", "N", "m", "s/m"]
     assert rows["track.link_stiffness"].split()[2] == "N/m"
+
+
+@pytest.mark.parametrize("args, says", [
+    (["run", "--duration", "x"], "trackbench run: Invalid value for '--duration'"),
+    (["study", "run", "s.toml", "--workers", "abc"], "trackbench study run: Invalid value for '--workers'"),
+    (["run", "--bogus", "1"], "trackbench run: No such option: --bogus"),
+    (["nosuch"], "trackbench: No such command 'nosuch'"),
+])
+def test_a_mistyped_option_is_one_line_too(args, says):
+    r = subprocess.run(CLI + args, capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and r.stdout == ""
+    err = one_line_error(r.stderr.strip())
+    assert says in err and err.endswith("--help')")

@@ -226,8 +226,28 @@ def record(
 
 
 
+def _usage_error():
+    """Click's UsageError, as the installed Typer has it (recent Typers carry their own Click)."""
+    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+
+
 def main():
-    app()
+    """The command; Click's own usage errors (an option of the wrong type, an unknown option or
+    command) in one line like the command's own, instead of a framed panel."""
+    import sys
+    try:
+        code = app(standalone_mode=False, prog_name="trackbench")
+    except _usage_error() as e:
+        if type(e).__name__ == "NoArgsIsHelpError":    # `trackbench study` alone: its help
+            e.show()
+            sys.exit(0)
+        where = e.ctx.command_path if e.ctx is not None else "trackbench"
+        typer.secho(f"error: {where}: {e.format_message()} (see '{where} --help')", fg=typer.colors.RED, err=True)
+        code = 2
+    except typer.Abort:
+        typer.secho("error: interrupted", fg=typer.colors.RED, err=True)
+        code = 130
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":
