@@ -285,6 +285,12 @@ def test_plot_study_one_figure_per_axis(tmp_path):
     res = CliRunner().invoke(app, ["plot", str(tmp_path / "st")])
     assert res.exit_code == 0, res.output
     assert (tmp_path / "st" / "plots" / "study_speed.png").exists()
+    # the study edited: height is no longer an axis; its old figure goes, the user's files stay
+    df[df["terrain.height"] == 0.1].to_csv(tmp_path / "st" / "summary.csv", index=False)
+    (tmp_path / "st" / "plots" / "notes.png").write_bytes(b"mine")
+    res = CliRunner().invoke(app, ["plot", str(tmp_path / "st")])
+    assert res.exit_code == 0 and "removed: " in res.output and "study_terrain_height.png" in res.output
+    assert sorted(p.name for p in (tmp_path / "st" / "plots").iterdir()) == ["notes.png", "study_speed.png"]
 
 
 def test_study_axes_have_units_and_readable_values():

@@ -182,7 +182,7 @@ def plot(
                                          "times spread over the run."),
 ):
     """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
-    from .replay.plots import plot_run, plot_study
+    from .replay.plots import plot_run, plot_study, remove_stale
     try:
         tt = None if times is None else tuple(float(x) for x in times.split(",") if x.strip())
     except ValueError:
@@ -197,6 +197,8 @@ def plot(
             if out is None:
                 out = path / "plots"
             paths = plot_study(path, out)
+            for p in remove_stale(out, paths):
+                typer.echo(f"removed: {p} (not a figure of this study's axes now)")
         else:
             paths = plot_run(path, out if out is not None else path / "plots", times=tt)
     except (FileNotFoundError, ValueError, ImportError) as e:

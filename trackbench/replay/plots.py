@@ -12,4 +12,4 @@ from .plot_common import (PAPER_TIMES, SOIL_DENT, axis_label, find_timeseries, l
                           run_label, value_label)
 from .run_figures import (_arrow_scale, choose_times, default_times, draw_configuration,  # noqa: F401
                           plot_configuration, plot_run)
-from .study_figures import _groups, plot_study, study_axes  # noqa: F401
+from .study_figures import _groups, plot_study, remove_stale, study_axes  # noqa: F401

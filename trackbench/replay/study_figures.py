@@ -237,6 +237,17 @@ def plot_study(study_dir, out_dir):
     return paths + ([drawbar] if drawbar else [])
 
 
+def remove_stale(out_dir, written):
+    """Remove the study figures (study_*.png) in out_dir that this plotting did not write: a
+    figure of an axis the edited study no longer has would pass for a current one. Returns
+    the removed paths."""
+    keep = {Path(p).resolve() for p in written}
+    stale = [p for p in sorted(Path(out_dir).glob("study_*.png")) if p.resolve() not in keep]
+    for p in stale:
+        p.unlink(missing_ok=True)
+    return stale
+
+
 def _has_drawbar(df, axes):
     """A drawbar study: drawbar.slip or drawbar.load a grid axis, or set (not 0) in its runs."""
     for c in ("drawbar.slip", "drawbar.load"):
