@@ -2,7 +2,7 @@
 Prints figures; asserts nothing. Takes several minutes.
 
     python benchmarks/bench_closed.py            # everything
-    python benchmarks/bench_closed.py drive      # one part: rest, drive, traction, step, cost
+    python benchmarks/bench_closed.py drive      # one part: rest, drive, profiles, traction, step, cost
 """
 
 import sys
@@ -92,6 +92,28 @@ def _span_moment(ds, sc, rows):
     return float(np.mean(out))
 
 
+# docs/validation.md, "The tooth profile": what differs from the default profile
+PROFILES = {"default": {}, "flanks 30 deg": {"sprocket.flank_angle": 30.0},
+            "flanks 35 deg": {"sprocket.flank_angle": 35.0}, "seat 35 mm": {"sprocket.seat_radius": 0.035},
+            "flanks 30 deg, tip r_p + 57 mm": {"sprocket.flank_angle": 30.0, "sprocket.tip_radius": 0.3806},
+            "ISO seat 27.5 mm, flanks 30 deg": {"sprocket.seat_radius": 0.0275, "sprocket.flank_angle": 30.0}}
+
+
+def profiles(duration=6.0):
+    """drive()'s run for each tooth profile of PROFILES: the mean torque over t >= 4 s against
+    (lower - upper span tension) x r_p, as tests/test_closed.py compares them."""
+    for name, over in PROFILES.items():
+        sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat"}, "speed": 0.0, "drive.kind": "speed",
+                                    "drive.target": 10.0, "duration": duration, "output_interval": 1e-3, **over})
+        ds = tb.simulate(sc)
+        late = ds.time.values >= 4.0
+        torque = ds.sprocket_torque.values[late].mean()
+        spans = np.nanmean(ds.lower_span_tension.values[late] - ds.upper_span_tension.values[late])
+        spans *= sc["sprocket.pitch_radius"]
+        print(f"profile {name}: {ds.attrs['status']}, mean torque {torque / 1e3:.2f} kN m, (lower - upper span) x r_p "
+              f"{spans / 1e3:.2f} kN m ({100 * (spans / torque - 1):+.1f} %), {ds.attrs['steps']} steps")
+
+
 def traction(torque=60e3, duration=1.0):
     """A torque above what mu x weight carries: the track slips, the tractive force stays at
     or below mu x weight."""
@@ -134,7 +156,7 @@ def cost():
               "target: at most 3)")
 
 
-PARTS = {"rest": rest, "drive": drive, "traction": traction, "step": step, "cost": cost}
+PARTS = {"rest": rest, "drive": drive, "profiles": profiles, "traction": traction, "step": step, "cost": cost}
 
 if __name__ == "__main__":
     for name in sys.argv[1:] or PARTS:
