@@ -11,7 +11,6 @@ from .atomic import atomic_path
 from .model import layout as L
 from .model.energy import paper_balance, work_residual
 from .model.kinematics import place_samples
-from .model.soil_force import plastic_sinkages
 from .status import Result
 from .version import MODEL_VERSION, __version__
 
@@ -206,8 +205,7 @@ def _soil(model, result, ground, placed):
     s = (px - seg[k, L.SEG_X0]) * seg[k, L.SEG_NX] + (py - seg[k, L.SEG_Y0]) * seg[k, L.SEG_NY]
     sink = np.maximum(par[L.P_PAD_GROUND] - s, 0.0)
     x = par[L.P_RUT_X0] + (np.arange(rut.size) + 0.5) * par[L.P_RUT_DX]
-    plastic = np.empty_like(rut)
-    plastic_sinkages(rut, par, plastic)
+    plastic = np.maximum(rut - par[L.P_SOIL_K] * rut ** par[L.P_SOIL_N] / par[L.P_SOIL_KE], 0.0)
     used = np.flatnonzero(rut > 0.0)
     lo, hi = (used[0], used[-1] + 1) if used.size else (0, 0)
     pull = d[:, L.D_GROUND_FX]

@@ -2,19 +2,14 @@
 
 Bekker's pressure-sinkage law p = (k_c / b + k_phi) z^n while the soil is loaded beyond the
 deepest sinkage z_m it has seen at that place; below z_m it unloads and reloads elastically,
-along a line of slope K_e (not above the first-loading curve) down to zero at the plastic
-sinkage (the rut). The line is reached across a band of UNLOADING_BAND below z_m in which the
-slope turns smoothly from Bekker's to K_e (unloading_pressure), so the law has no kink at z_m
-(a pin loading the soil sits there, and every small reversal crossed a kink the step-size
-control had to locate) and the line lies a little above p(z_m) - K_e (z_m - z): about
-K_e delta / 2, i.e. the rut is about delta / 2 shallower.
+p = p(z_m) - K_e (z_m - z) (not above the first-loading curve), down to zero at the plastic
+sinkage z_m - p(z_m) / K_e (the rut).
 z_m is the soil's memory along x: one node per cell centre (ModelArrays.rut), smoothly
 interpolated between the two nodes around x (rut_nodes), so that a pin sliding along the
 ground meets a memory with no jumps and no kinks (a jump in z_m is a jump in the elastic
 branch's pressure, which every step across a cell boundary met and was rejected at). It is
 raised only after an accepted step (remember_sinkage), so a rejected step leaves no trace,
-and the pressure and its slopes (along z and x) are continuous where it is raised: at z = z_m
-both branches agree with their slopes, so raising z_m to a pin's sinkage moves neither.
+and the pressure is continuous where it is raised (at z = z_m both branches agree).
 
 Shear by Janosi-Hanamoto, tau = (c + p tan phi)(1 - exp(-j / K)), on the pin's area A: the
 shear displacement j is the pin's displacement along the surface since it touched the soil
@@ -32,8 +27,6 @@ from .layout import (P_RUT_DX, P_RUT_X0, P_SOIL, P_SOIL_COHESION, P_SOIL_K, P_SO
 
 
 SURFACE_DEPTH = 1e-3     # m: for n < 1, Bekker's curve runs straight to the surface from here
-UNLOADING_BAND = 5e-4    # m: delta, over which unloading stiffens from Bekker's slope to K_e
-                         # (docs/model.md, soft soil: 0.2 mm saved no step, 0.5 mm 6 %)
 
 
 @njit(**SCALAR)
@@ -46,90 +39,16 @@ def first_loading(z, n, k):
 
 
 @njit(**SCALAR)
-def loading_slope(z, p, n):
-    """(chord, slope, curvature) of the first-loading curve at z > 0 where it gives p: the
-    chord p / z from the surface, the slope n p / z and curvature n (n - 1) p / z^2 on
-    Bekker's curve (no second power taken), p / z and 0 on the straight part near the
-    surface. 1 / z is taken beside the power that gives p, not after it."""
-    inv_z = 1.0 / z
-    chord = p * inv_z
-    if n < 1.0 and z < SURFACE_DEPTH:
-        return chord, chord, 0.0
-    slope = n * chord
-    return chord, slope, (n - 1.0) * slope * inv_z
-
-
-@njit(**SCALAR)
-def unloading_band(p_m, slope, curvature, ke):
-    """(width, F(width)) of the band below z_m over which the unloading slope turns from
-    Bekker's to K_e (unloading_pressure): UNLOADING_BAND, narrower where the soil's pressure
-    at z_m would not last the band (p(z_m) / K_e, so that p reaches zero below the band);
-    F(width) is the pressure lost across it."""
-    width = UNLOADING_BAND if p_m >= ke * UNLOADING_BAND else p_m / ke
-    return width, 0.5 * (slope + ke) * width - curvature * width * width / 12.0
-
-
-@njit(**SCALAR)
-def unloading_pressure(z, z_max, n, k, ke):
-    """p(z_m) - F(z_m - z) below the deepest sinkage z_m = z_max (> z), never above the
-    first-loading curve: the elastic line of slope K_e, reached across a band of width delta
-    (unloading_band) in which the slope F' turns from Bekker's at z_m to K_e as the Hermite
-    cubic in u = (z_m - z) / delta with Bekker's curvature at z_m and none at delta. So the
-    law has no kink at z_m: a pin that loads the soil, stops and lifts off meets a pressure
-    with continuous slope and curvature, and raising z_m to the pin's sinkage after a step
-    changes neither."""
-    p_m = first_loading(z_max, n, k)
-    chord, slope, curvature = loading_slope(z_max, p_m, n)
-    width, drop = unloading_band(p_m, slope, curvature, ke)
-    d = z_max - z
-    if d >= width:
-        p = p_m - drop - ke * (d - width)
-        if p <= 0.0:
-            return p      # in the rut
-    else:
-        u = d * (1.0 / UNLOADING_BAND) if width == UNLOADING_BAND else d / width
-        # F(d) = S d + (K_e - S) delta (u^3 - u^4/2) - p''(z_m) delta^2 (u^2/2 - 2 u^3/3 + u^4/4)
-        ramp = u * u * u * (1.0 - 0.5 * u)
-        bend = u * u * (0.5 + u * (u * 0.25 - 2.0 / 3.0))
-        p = p_m - slope * d - (ke - slope) * width * ramp + curvature * width * width * bend
-    # Not above the first-loading curve (for n < 1 it is steeper near the surface than a
-    # soft K_e; Chrono's SCM takes the smaller alike). That curve lies above its chord from
-    # the surface to z_m for n <= 1 (concave) and above its tangent at z_m for n > 1
-    # (convex): below those it cannot cap p, and its power is spared (most pins in the
-    # soil are below z_m: one power of two a pin).
-    floor = chord * z if n <= 1.0 else p_m - slope * d
-    if p <= floor:
-        return p
-    return min(p, first_loading(z, n, k))
-
-
-@njit(**SCALAR)
-def plastic_sinkage(z_max, n, k, ke):
-    """The rut: the sinkage below z_m = z_max at which the unloading pressure reaches zero
-    (0 on fresh soil)."""
-    if z_max <= 0.0:
-        return 0.0
-    p_m = first_loading(z_max, n, k)
-    _, slope, curvature = loading_slope(z_max, p_m, n)
-    width, drop = unloading_band(p_m, slope, curvature, ke)
-    return max(z_max - width - max(p_m - drop, 0.0) / ke, 0.0)
-
-
-@njit(**KERNEL)
-def plastic_sinkages(rut, par, out):
-    """out[c] = the plastic sinkage under memory node c (the rut the soil keeps there)."""
-    for c in range(rut.shape[0]):
-        out[c] = plastic_sinkage(rut[c], par[P_SOIL_N], par[P_SOIL_K], par[P_SOIL_KE])
-
-
-@njit(**SCALAR)
 def soil_pressure(z, z_max, n, k, ke):
     """Pressure (Pa) at sinkage z where the soil has been pressed down to z_max before."""
     if z <= 0.0:
         return 0.0
+    loading = first_loading(z, n, k)
     if z >= z_max:
-        return first_loading(z, n, k)
-    return max(unloading_pressure(z, z_max, n, k, ke), 0.0)
+        return loading
+    # the elastic line, but never above the first-loading curve (for n < 1 that curve is
+    # steeper than any K_e near the surface; Chrono's SCM takes the smaller alike)
+    return max(min(first_loading(z_max, n, k) - ke * (z_max - z), loading), 0.0)
 
 
 @njit(**INLINE)
@@ -162,15 +81,22 @@ def pin_on_soil(x, z, par, rut):
     return soil_pressure(z, deepest_sinkage(x, par, rut), par[P_SOIL_N], par[P_SOIL_K], par[P_SOIL_KE])
 
 
-KINK_TOL = 1e-12      # m: a pin within this of the plastic sinkage is on it
+KINK_MEMORY = 0       # soil_kink: at the deepest sinkage z_m, loading meets the elastic line
+KINK_PLASTIC = 1      # at the plastic sinkage, the elastic line reaches zero pressure
+N_KINKS = 2
+KINK_TOL = 1e-12      # m: a pin within this of a kink is on it (z_m is raised to the sinkage
+                      # reached after an accepted step, up to rounding)
 
 
 @njit(**INLINE)
-def soil_kink(x, z, par, rut):
-    """z minus the plastic sinkage at x, for the event location: the law's slope jumps
-    there (from K_e to none) and a step across it is rejected unless it ends there. (At
-    z_m the law has no kink: unloading_pressure.)"""
-    return z - plastic_sinkage(deepest_sinkage(x, par, rut), par[P_SOIL_N], par[P_SOIL_K], par[P_SOIL_KE])
+def soil_kink(x, z, kink, par, rut):
+    """z minus the depth of a kink of the pressure law at x, for the event location: the
+    law's slope jumps there (from Bekker's to K_e, from K_e to none) and a step across it
+    is rejected unless it ends there."""
+    zm = deepest_sinkage(x, par, rut)
+    if kink == KINK_PLASTIC:
+        zm -= first_loading(zm, par[P_SOIL_N], par[P_SOIL_K]) / par[P_SOIL_KE]
+    return z - zm
 
 
 @njit(**INLINE)

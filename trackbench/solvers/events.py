@@ -23,7 +23,7 @@ from ..model.gaps import (ground_distance, link_frame, pin_cap_weight, pin_groun
                           segment_coords)
 from ..model.contact_laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ..model.jit import BORROW, INLINE, KERNEL
-from ..model.soil_force import KINK_TOL, soil_kink
+from ..model.soil_force import KINK_TOL, N_KINKS, soil_kink
 from ..model.kinematics import body_offset, place, wheel_offset
 from ..model.loop import guide_offset, place_loop
 from ..model.sprocket import pin_on_teeth, tooth_shape
@@ -227,19 +227,19 @@ def _probe_at(kind, i, w, step, nq, m, ev):
 
 
 @njit(**BORROW)   # called, not inlined: each inlined copy cost ~25 s of compile time
-def _gap_at(kind, i, b, t, step, nq, m, n_links, ev, kink=False):
+def _gap_at(kind, i, b, t, step, nq, m, n_links, ev, kink=-1):
     """(valid, gap) of one candidate pair at fraction t of the step: kind K_*, i the wheel,
     guide or corner (the pin for K_PIN_GROUND and K_TEETH), b the link or pin (the segment
-    for K_PIN_GROUND). kink (soft soil, K_PIN_GROUND): the pin's sinkage minus the depth of
-    the soil's plastic sinkage there (its pressure law's kink) instead."""
+    for K_PIN_GROUND). kink >= 0 (soft soil, K_PIN_GROUND): the pin's sinkage minus the
+    depth of that kink of the soil's pressure law instead."""
     if kind == K_TEETH:
         return True, _teeth_gap_at(i, t, step, nq, m, n_links, ev)
     w = quintic_basis(t)
     if kind == K_PIN_GROUND:
         px, py = _pin_at(i, w, step, nq, m, n_links, ev)
         valid, g = _pin_ground(px, py, b, m, m.nbr_rows[K_PIN_GROUND] + i)
-        if kink:
-            g = soil_kink(px, g, m.par, m.rut)
+        if kink >= 0:
+            g = soil_kink(px, g, kink, m.par, m.rut)
         return valid, g
     p = _probe_at(kind, i, w, step, nq, m, ev)
     a = _pin_at(b, w, step, nq, m, n_links, ev)
@@ -275,7 +275,7 @@ def _gap_end(kind, i, b, e, m, ev):
 
 
 @njit(**BORROW)
-def _bisect(kind, i, b, g0, level, step, nq, m, n_links, ev, kink=False):
+def _bisect(kind, i, b, g0, level, step, nq, m, n_links, ev, kink=-1):
     """Upper end of the bracket where the gap (or the soil's kink function) crosses level
     (just after the kink)."""
     lo = 0.0
@@ -365,16 +365,19 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
 
 @njit(**BORROW)
 def _soil_switch(i, b, sinkage, best, step, nq, m, ev):
-    """min(best, the smallest t at which pin i on soft soil (on segment b) crosses the kink
-    of the soil's pressure law, its plastic sinkage (soil_force.soil_kink; the law is
-    smooth at z_m). Only a crossing before best is bisected (one look at best first)."""
+    """min(best, the smallest t at which pin i on soft soil (on segment b) crosses a kink of
+    the soil's pressure law, soil_force.soil_kink). A pin left on its loading curve by the
+    last step (z = z_m) counts as above z_m: the kink is where it comes back below. Only a
+    crossing before best is bisected (most steps hold several: one look at best first)."""
     n_links = ev.pins0.shape[0] - 1
-    f0 = soil_kink(ev.pins0[i, 0], sinkage[0], m.par, m.rut)
-    f1 = soil_kink(ev.pins1[i, 0], sinkage[1], m.par, m.rut)
-    if (f0 > -KINK_TOL) == (f1 > -KINK_TOL):
-        return best
-    if best < 1.0:
-        _, f_best = _gap_at(K_PIN_GROUND, i, b, best, step, nq, m, n_links, ev, True)
-        if (f_best > -KINK_TOL) == (f0 > -KINK_TOL):
-            return best
-    return min(best, _bisect(K_PIN_GROUND, i, b, f0, -KINK_TOL, step, nq, m, n_links, ev, True))
+    for kink in range(N_KINKS):
+        f0 = soil_kink(ev.pins0[i, 0], sinkage[0], kink, m.par, m.rut)
+        f1 = soil_kink(ev.pins1[i, 0], sinkage[1], kink, m.par, m.rut)
+        if (f0 > -KINK_TOL) == (f1 > -KINK_TOL):
+            continue
+        if best < 1.0:
+            _, f_best = _gap_at(K_PIN_GROUND, i, b, best, step, nq, m, n_links, ev, kink)
+            if (f_best > -KINK_TOL) == (f0 > -KINK_TOL):
+                continue
+        best = min(best, _bisect(K_PIN_GROUND, i, b, f0, -KINK_TOL, step, nq, m, n_links, ev, kink))
+    return best
