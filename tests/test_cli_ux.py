@@ -214,6 +214,9 @@ def test_version_and_help_shows_flags_and_choices():
         assert re.search(r"--storage\s+full\|compact", text)
     assert re.search(r"--executor\s+local\|dask", study_help)
     assert "[study] storage" in study_help and "[study] output" in study_help   # not eaten as markup
+    for args in ([], ["study"], ["run"], ["study", "run"], ["plot"]):     # Typer's own --help flag too
+        _, text = invoke(args + ["--help"])
+        assert re.search(r"--help\s+Show this message", text) and "<bool>" not in text
 
 
 def test_params_lists_each_unit_in_its_own_column():

@@ -4,11 +4,30 @@ from pathlib import Path
 from typing import List, Optional
 
 import typer
+from typer.core import TyperCommand, TyperGroup
 
-app = typer.Typer(add_completion=False, no_args_is_help=True,
+
+def _untyped(option):
+    """Typer labels its own --help flag `<bool>`; a flag takes no value, so no label."""
+    if option is not None:
+        option.metavar = ""
+    return option
+
+
+class _Command(TyperCommand):
+    def get_help_option(self, ctx):
+        return _untyped(super().get_help_option(ctx))
+
+
+class _Group(TyperGroup):
+    def get_help_option(self, ctx):
+        return _untyped(super().get_help_option(ctx))
+
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, cls=_Group,
                   help="Dynamics of high-mobility tracked vehicles (K. Lee, 2000).")
 STORAGE = "full|compact"
-study_app = typer.Typer(no_args_is_help=True, help="Run and read parameter studies (TOML).")
+study_app = typer.Typer(no_args_is_help=True, cls=_Group, help="Run and read parameter studies (TOML).")
 app.add_typer(study_app, name="study")
 
 
@@ -30,7 +49,7 @@ def _main(version: bool = typer.Option(False, "--version", metavar="", callback=
     """Dynamics of high-mobility tracked vehicles (K. Lee, 2000)."""
 
 
-@app.command()
+@app.command(cls=_Command)
 def run(
     set_: List[str] = typer.Option([], "--set", "-s", metavar="NAME=VALUE", help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15"),
     duration: Optional[float] = typer.Option(None, help="Simulated time (s); default: the scenario's (0.5 s)."),
@@ -56,7 +75,7 @@ def run(
         raise typer.Exit(1)
 
 
-@app.command()
+@app.command(cls=_Command)
 def params():
     """List every parameter name with its paper value and what is allowed."""
     from .runner import parameter_table
@@ -83,7 +102,7 @@ def _study_folder_or_fail(path: Path):
         _fail(str(e))
 
 
-@study_app.command("run")
+@study_app.command("run", cls=_Command)
 def study_run(
     file: Path = typer.Argument(..., help="Study file (TOML), e.g. studies/speed_sweep.toml."),
     workers: int = typer.Option(2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."),
@@ -128,7 +147,7 @@ def study_run(
         _fail(outcome.problem(), code=1)
 
 
-@study_app.command("summary")
+@study_app.command("summary", cls=_Command)
 def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
     """Print the study's summary table (rebuilt from the runs' run.json; summary files rewritten)."""
     from .study.summary import format_table, write_summary
@@ -137,7 +156,7 @@ def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or it
     typer.echo(format_table(df, rep, study.param_names))
 
 
-@study_app.command("status")
+@study_app.command("status", cls=_Command)
 def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
     """Show how many runs are done, failed and pending."""
     from .study.runner import status_counts
@@ -155,7 +174,7 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
 
 # --- replay commands ---------------------------------------------------------------
 
-@app.command()
+@app.command(cls=_Command)
 def view(
     path: Path = typer.Argument(..., help="A run folder (recording.rrd inside), an .rrd or .nc file, or a study "
                                           "(results folder or TOML) followed by RUN_ID."),
@@ -172,7 +191,7 @@ def view(
     raise typer.Exit(code)
 
 
-@app.command()
+@app.command(cls=_Command)
 def plot(
     path: Path = typer.Argument(..., help="A run (.nc file or run folder) or a study (results folder or TOML)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", help="Folder for the PNG files; default: "
@@ -207,7 +226,7 @@ def plot(
         typer.echo(f"written: {p}")
 
 
-@app.command()
+@app.command(cls=_Command)
 def record(
     nc: Path = typer.Argument(..., help="A run's netCDF file (or a run folder holding timeseries.nc)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", help="The .rrd file; default: beside the .nc "
