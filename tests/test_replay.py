@@ -626,7 +626,7 @@ def test_a_soil_study_figure_has_panels_for_sinkage_pull_and_slip():
     """Each in its own unit (the soft_soil study's question: drawbar pull and sinkage); a
     rigid-ground study keeps the two force panels."""
     import pandas as pd
-    from trackbench.replay.study_figures import _panels
+    from trackbench.replay.study_figures import _panels, _what
     df = pd.DataFrame({"peak_wheel1_force_y": [1e5], "peak_ground_force_y": [3e5], "peak_sinkage": [0.06],
                        "mean_drawbar_pull": [1.8e3], "mean_slip": [0.013]})
     panels = {label: (cols, scale) for label, cols, scale in _panels(df)}
@@ -635,3 +635,17 @@ def test_a_soil_study_figure_has_panels_for_sinkage_pull_and_slip():
     assert panels["mean slip (sprocket), 2nd half (%)"] == (["mean_slip"], 1e-2)
     assert panels["peak force (kN)"][0] == ["peak_ground_force_y"]      # the mean pull not among peaks
     assert len(_panels(df.drop(columns=["peak_sinkage", "mean_drawbar_pull", "mean_slip"]))) == 2
+    assert _what(_panels(df)) == "peak forces, sinkage, drawbar pull and slip"
+    assert _what(_panels(df[["peak_wheel1_force_y"]])) == "peak forces"
+
+
+def test_a_closed_track_study_figure_has_a_sprocket_torque_panel():
+    """The drive study's question: sprocket torque (kN m) beside the forces; its idler force
+    among the peak forces (kN)."""
+    import pandas as pd
+    from trackbench.replay.study_figures import _panels, _what
+    df = pd.DataFrame({"peak_wheel1_force_y": [1e5], "peak_idler_force": [1.5e5], "peak_sprocket_torque": [1.4e4]})
+    panels = {label: (cols, scale) for label, cols, scale in _panels(df)}
+    assert panels["peak sprocket torque (kN m)"] == (["peak_sprocket_torque"], 1e3)
+    assert panels["peak force (kN)"][0] == ["peak_idler_force"]
+    assert _what(_panels(df)) == "peak forces and sprocket torque"

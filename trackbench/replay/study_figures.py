@@ -188,25 +188,39 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
         axs[-1, 0].set_xticks(range(len(raw)), labels, rotation=25 if tilt else 0, ha="right" if tilt else "center")
     axs[-1, 0].set_xlabel(axis_label(axis, col.dropna().to_numpy() if numeric else ()))
     note = _note(axis, others, tied, grouped, too_many, np.isfinite(x_all).sum() > len(order))
-    what = "peak forces" if len(panels) <= 2 else "peak forces, sinkage, drawbar pull and slip"
+    what = _what(panels)
     fig.suptitle(_wrap(f"study {src.parent.name}: {what} against {axis}{note}", 110 if grouped else 85),
                  fontsize=10)
     return fig
 
 
+# the panels beyond the forces, each alone in its own unit, and what the title calls them
+_OWN_PANELS = {"peak_sprocket_torque": "sprocket torque", "peak_sinkage": "sinkage",
+               "mean_drawbar_pull": "drawbar pull", "mean_slip": "slip"}
+
+
+def _what(panels):
+    """The figure title's list of what it shows: 'peak forces, sprocket torque and slip'."""
+    own = [_OWN_PANELS[cols[0]] for _, cols, _ in panels if cols and cols[0] in _OWN_PANELS]
+    names = ["peak forces"] + own
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
 def _panels(df):
     """(y label, summary columns, SI value of one display unit) of each panel: the wheels' peak
-    forces, the other peak forces, and on soft soil the deepest sinkage, the mean drawbar pull
-    and the mean slip, each alone (their own units)."""
+    forces, the other peak forces, and those of the closed track and the soft soil (the peak
+    sprocket torque, the deepest sinkage, the mean drawbar pull and the mean slip), each alone
+    (their own units)."""
     from ..quantities import BY_NAME, PEAKS
     forces = [q.name for q in PEAKS if q.unit == "kN" and q.kind == "peak" and not q.per_wheel and q.name in df.columns]
     panels = [("peak vertical wheel-track force (kN)", _wheel_columns(df), 1e3)]
     if forces:
         panels.append(("peak force (kN)", forces, 1e3))
-    for name in ("peak_sinkage", "mean_drawbar_pull", "mean_slip"):
+    for name in _OWN_PANELS:
         if name in df.columns and df[name].notna().any():
             q = BY_NAME[name]
-            panels.append((f"{q.label} ({q.unit})", [name], q.per_unit))
+            label = "peak sprocket torque" if name == "peak_sprocket_torque" else q.label  # fits the panel's height
+            panels.append((f"{label} ({q.unit})", [name], q.per_unit))
     return panels
 
 
