@@ -649,3 +649,14 @@ def test_a_closed_track_study_figure_has_a_sprocket_torque_panel():
     assert panels["peak sprocket torque (kN m)"] == (["peak_sprocket_torque"], 1e3)
     assert panels["peak force (kN)"][0] == ["peak_idler_force"]
     assert _what(_panels(df)) == "peak forces and sprocket torque"
+
+
+def test_study_figures_are_titled_by_the_study_name_not_its_folder(tmp_path):
+    """`study run --output elsewhere` names the folder; the figures keep the study's name."""
+    import json
+    from trackbench.replay.study_figures import _study_name
+    (tmp_path / "elsewhere").mkdir()
+    src = tmp_path / "elsewhere" / "summary.csv"
+    assert _study_name(src) == "elsewhere"                     # no runs.json: the folder
+    (tmp_path / "elsewhere" / "runs.json").write_text(json.dumps({"name": "soft_soil", "runs": []}))
+    assert _study_name(src) == "soft_soil"

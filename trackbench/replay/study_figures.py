@@ -53,6 +53,12 @@ MAX_LINES = 6        # one line per value of the other axes up to this many, els
 _STYLES = [("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1, 1, 1)), "v"), ((0, (1, 3)), "P")]
 
 
+def _study_name(src):
+    """The study's own name (runs.json), not its results folder's, which --output may have set."""
+    from ..study.store import read_json
+    return (read_json(src.parent / "runs.json") or {}).get("name") or src.parent.name
+
+
 def _run_scenarios(src):
     """run id -> resolved scenario, from the study's runs.json ({} without one)."""
     from ..study.store import read_json
@@ -189,7 +195,7 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
     axs[-1, 0].set_xlabel(axis_label(axis, col.dropna().to_numpy() if numeric else ()))
     note = _note(axis, others, tied, grouped, too_many, np.isfinite(x_all).sum() > len(order))
     what = _what(panels)
-    fig.suptitle(_wrap(f"study {src.parent.name}: {what} against {axis}{note}", 110 if grouped else 85),
+    fig.suptitle(_wrap(f"study {_study_name(src)}: {what} against {axis}{note}", 110 if grouped else 85),
                  fontsize=10)
     return fig
 
@@ -339,7 +345,7 @@ def _plot_drawbar_pull(src, ok, out, has_drawbar=False):
     ax.set_ylabel("drawbar pull (kN)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    ax.set_title(_wrap(f"study {src.parent.name}: drawbar pull against the soil's slip (means over each run's "
+    ax.set_title(_wrap(f"study {_study_name(src)}: drawbar pull against the soil's slip (means over each run's "
                        "second half); the numbers at the points: the slip at the sprocket the towing rig held", 90),
                  fontsize=10)
     path = out / "study_drawbar_pull.png"
