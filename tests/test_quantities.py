@@ -5,7 +5,7 @@ import pandas as pd
 
 from trackbench import output, quantities
 from trackbench.replay.plots import study_axes
-from trackbench.study.executors import run_summary
+from trackbench.quantities import run_summary
 
 SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1"}
 

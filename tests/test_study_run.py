@@ -328,7 +328,7 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
 
 
 def test_one_warm_scenario_per_kind_of_compiled_model():
-    from trackbench.study.executors import warm_kinds
+    from trackbench.study.warming import warm_kinds
     paper = tb.Scenario.paper().to_dict()
     runs = [paper, {**paper, "speed": 5.0}, tb.Scenario.paper(**{"terrain.soil": "lete_sand"}).to_dict(),
             tb.Scenario.paper(**{"track.layout": "closed"}).to_dict(), tb.Scenario.paper(method="dop853").to_dict()]

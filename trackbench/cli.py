@@ -118,7 +118,8 @@ def study_run(
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
     study = _load_study_or_fail(file, output)   # a bad study file fails here, before the solver libraries load
-    from .study.executors import check_arguments, start_workers, warm_kinds
+    from .study.executors import check_arguments, start_workers
+    from .study.warming import warm_kinds
     from .study.runner import check_output
     try:
         check_arguments(workers, executor, scheduler, storage)

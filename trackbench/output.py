@@ -156,7 +156,7 @@ def _span_tensions(model, q, pins, tension, g):
 
 def _closed_layout(model, result, scenario, placed):
     """The closed layout's own variables: sprocket, idler, drive, span tensions."""
-    from .simulate import closed_parts
+    from .assembly import closed_parts
     g = closed_parts(scenario)[0]
     nw, nl, nq = model.nw, model.n_links, model.nq
     q, qd, d, y = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag, result.y
@@ -235,7 +235,7 @@ def _soil(model, result, ground, placed):
 
 
 def _closed_attrs(scenario):
-    from .simulate import closed_parts
+    from .assembly import closed_parts
     g, lp, guides = closed_parts(scenario)
     return {"track_layout": "closed", "closed_layout": json.dumps({
         "sprocket": g.sprocket.tolist(), "teeth": int(lp[L.LP_TEETH]), "pitch_radius": g.pitch_radius,

@@ -159,6 +159,11 @@ def without_nan(d):
     return {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in d.items()}
 
 
+def run_summary(ds):
+    """The numbers of a run the summary shows (plain floats, SI units; NaN -> None)."""
+    return without_nan(values(ds))
+
+
 def tensioner_energy(ds):
     """The tensioner spring's potential along the idler's guide, U = -F0 s + k s^2 / 2 (s from
     the guide's middle, where the spring pushes with its preload F0), or None without an idler.

@@ -338,7 +338,7 @@ def _balance(P, u):
 
 def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=1e-12, max_iter=60):
     """Newton's method from the wheels resting on the track and the track on the ground
-    (soil: {P_* index: value} of soft soil, simulate.soil_par). A power law is reached by
+    (soil: {P_* index: value} of soft soil, assembly.soil_par). A power law is reached by
     continuation (_continuation)."""
     P = _Problem(vehicle, track, gravity, contact, soil)
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]

@@ -20,18 +20,14 @@ from concurrent.futures.process import BrokenProcessPool
 from datetime import datetime, timezone
 from pathlib import Path
 
+from ..quantities import run_summary
 from ..storage import recording_steps
 from . import store
+from .warming import WARM, compile_flag
 
 
 def _now():
     return datetime.now(timezone.utc).isoformat(timespec="seconds")
-
-
-def run_summary(ds):
-    """The numbers of a run the summary shows (plain floats, SI units; NaN -> None)."""
-    from .. import quantities as Q
-    return Q.without_nan(Q.values(ds))
 
 
 def _record(ds, rdir, scenario, storage="full"):
@@ -273,26 +269,6 @@ def _context():
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload([PRELOAD])
     return ctx
-
-
-WARM = "TRACKBENCH_WARM"    # what the fork server's preload warms: JSON {"scenarios": [...], "flag": path}
-MAX_WARM = 4
-
-
-def warm_kinds(scenarios):
-    """One scenario dict of each kind of compiled model among a study's runs (solver, track
-    layout and method each compile their own time loop; the soil, friction and contact
-    options are flags inside it), at most MAX_WARM."""
-    kinds = {}
-    for d in scenarios:
-        kinds.setdefault((d.get("solver"), d.get("track", {}).get("layout"), d.get("method")), d)
-    return list(kinds.values())[:MAX_WARM]
-
-
-def compile_flag():
-    """The file where this command's fork server says that it compiles (the progress shows it)."""
-    import tempfile
-    return Path(tempfile.gettempdir()) / f"trackbench-compiling-{os.getpid()}.json"
 
 
 def start_workers(executor="local", scheduler=None, warm=None):

@@ -50,9 +50,8 @@ def warm():
     import pandas  # noqa: F401  (the summary of a run's results)
     import xarray  # noqa: F401
 
-    import trackbench
     from trackbench.output import write_netcdf
-    from trackbench.study import executors
+    from trackbench.quantities import run_summary
 
     _orphaned()
     ds = None
@@ -62,18 +61,18 @@ def warm():
     _orphaned()
     if ds is None:
         return
-    executors.run_summary(ds)
+    run_summary(ds)
     with tempfile.TemporaryDirectory() as tmp:
         write_netcdf(ds, Path(tmp) / "warm.nc")
 
 
 def _kinds():
-    """The scenarios to warm: the study's kinds of model (executors.WARM), else the paper's."""
+    """The scenarios to warm: the study's kinds of model (warming.WARM), else the paper's."""
     import json
 
     import trackbench
-    from trackbench.study import executors
-    spec = json.loads(os.environ.get(executors.WARM) or "{}")
+    from trackbench.study.warming import WARM
+    spec = json.loads(os.environ.get(WARM) or "{}")
     short = {"duration": 1e-3, "output_interval": 1e-3}
     kinds = spec.get("scenarios") or [None]
     for d in kinds:

@@ -11,7 +11,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from . import executors, store
+from . import executors, store, warming
 from .spec import Study, StudyError, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
@@ -226,9 +226,9 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
         if tasks:   # they load while this process sets up
-            executors.start_workers(executor, scheduler, warm=executors.warm_kinds(t["scenario"] for t in tasks))
+            executors.start_workers(executor, scheduler, warm=warming.warm_kinds(t["scenario"] for t in tasks))
         out.skipped = len(done)
-        progress = _Progress(len(tasks), len(done), quiet, workers=workers, flag=executors.compile_flag())
+        progress = _Progress(len(tasks), len(done), quiet, workers=workers, flag=warming.compile_flag())
         if executor == "dask":
             stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
         else:
@@ -244,7 +244,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         finally:
             stream.close()
             progress.close()
-            executors.compile_flag().unlink(missing_ok=True)
+            warming.compile_flag().unlink(missing_ok=True)
             store.clean_tmp(study.output)  # what killed workers left half-written
             _summarise(study, out)
     out.elapsed = time.perf_counter() - t0
