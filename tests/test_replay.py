@@ -537,11 +537,15 @@ def test_soil_recording_logs_the_deformed_surface(soil_run, soil_recording):
     np.testing.assert_allclose(strips[-1, [0, -1]] * [1, -1], ground[[0, -1]], atol=1e-5)
 
 
-def _raise_nodes(rut, x, z, x0, dx):
+def _raise_nodes(rut, x, z, x0, dx, half):
     """The soil memory's rule written out again: nodes at cell centres, quintic weights,
-    the shallower node raised just enough (both when z is deeper than both)."""
+    the shallower node raised just enough (both when z is deeper than both), every other
+    node under the pin's shoe (within half a link of x) to z where it is shallower."""
     u = (x - x0) / dx - 0.5
     c = int(np.floor(u))
+    centres = x0 + (np.arange(rut.size) + 0.5) * dx
+    shoe = (np.abs(centres - x) <= half) & (np.arange(rut.size) != c) & (np.arange(rut.size) != c + 1)
+    rut[shoe] = np.maximum(rut[shoe], z)
     if c < 0 or c + 1 >= rut.size:
         return
     u -= c
@@ -564,13 +568,14 @@ def test_soil_dent_matches_an_independent_rebuild(soil_run):
     dx = rx[1] - rx[0]
     n = ds.sizes["time"]
     edges = np.append(rx - dx / 2, rx[-1] + dx / 2)
+    half = 0.5 * json.loads(ds.attrs["scenario"])["track"]["link_length"]
     hist, last = G.running_sinkage(ds, np.arange(n), edges)
     want = np.zeros((n, rx.size))
     rut = np.zeros(rx.size)
     for i in range(n):
         for x, s in zip(ds["pin_x"].values[i], ds["sinkage"].values[i]):
             if s > 0:
-                _raise_nodes(rut, x, s, edges[0], edges[1] - edges[0])
+                _raise_nodes(rut, x, s, edges[0], edges[1] - edges[0], half)
         want[i] = rut
     np.testing.assert_array_equal(hist, want)
     np.testing.assert_array_equal(last, want[-1])

@@ -22,8 +22,8 @@ import numpy as np
 from numba import njit
 
 from .jit import BORROW, INLINE, KERNEL, SCALAR
-from .layout import (P_RUT_DX, P_RUT_X0, P_SOIL, P_SOIL_COHESION, P_SOIL_K, P_SOIL_KE, P_SOIL_N, P_SOIL_SHEAR_K,
-                     P_SOIL_TAN_PHI)
+from .layout import (P_LINK_LENGTH, P_RUT_DX, P_RUT_X0, P_SOIL, P_SOIL_COHESION, P_SOIL_K, P_SOIL_KE, P_SOIL_N,
+                     P_SOIL_SHEAR_K, P_SOIL_TAN_PHI)
 
 
 SURFACE_DEPTH = 1e-3     # m: for n < 1, Bekker's curve runs straight to the surface from here
@@ -100,12 +100,22 @@ def soil_kink(x, z, kink, par, rut):
 
 
 @njit(**INLINE)
-def raise_memory(x, z, x0, dx, rut):
-    """Raise the nodes around x, never lowering one, so that z_m at x becomes z (when z is
-    deeper): both to z if z is deeper than both, else only the shallower one, just enough.
-    No node ends deeper than the deeper of its old value and z: a sliding pin leaves the
-    sinkage it reached, not more."""
-    c, wr = rut_nodes(x, x0, dx, rut.shape[0])
+def raise_memory(x, z, x0, dx, half, rut):
+    """A pin at x sunk by z stands for a shoe of its link's length: the soil under the whole
+    shoe is pressed to z. The nodes around x are raised, never lowered, just enough that z_m
+    at x becomes z (when z is deeper): both to z if z is deeper than both, else only the
+    shallower one; every other node within `half` of x (the shoe's half length) to z where
+    it is shallower. No node ends deeper than the deeper of its old value and a sinkage
+    reached within half a shoe of it: a sliding pin leaves the sinkage it reached, not
+    more; the next pin, a link away, is beyond its neighbour's shoe, so raising one shoe
+    never moves the memory under another pin."""
+    n = rut.shape[0]
+    c, wr = rut_nodes(x, x0, dx, n)
+    lo_i = max(int(math.ceil((x - half - x0) / dx - 0.5)), 0)
+    hi_i = min(int(math.floor((x + half - x0) / dx - 0.5)), n - 1)
+    for i in range(lo_i, hi_i + 1):
+        if i != c and i != c + 1 and rut[i] < z:
+            rut[i] = z
     if c < 0 or z <= (1.0 - wr) * rut[c] + wr * rut[c + 1]:
         return
     lo, hi = (c, c + 1) if rut[c] <= rut[c + 1] else (c + 1, c)
@@ -118,16 +128,17 @@ def raise_memory(x, z, x0, dx, rut):
 
 
 @njit(**KERNEL)
-def replay_memory(px, sink, x0, dx, idx, out):
+def replay_memory(px, sink, x0, dx, half, idx, out):
     """The memory rebuilt from output samples (pin x and sinkage per sample), raised by the
-    rule above at each sample instead of after each step: out[j] = the nodes after sample
-    idx[j] (idx sorted). Returns the nodes after the last sample."""
+    rule above (shoes of half length `half`) at each sample instead of after each step:
+    out[j] = the nodes after sample idx[j] (idx sorted). Returns the nodes after the last
+    sample."""
     rut = np.zeros(out.shape[1])
     j = 0
     for i in range(px.shape[0]):
         for b in range(px.shape[1]):
             if sink[i, b] > 0.0:
-                raise_memory(px[i, b], sink[i, b], x0, dx, rut)
+                raise_memory(px[i, b], sink[i, b], x0, dx, half, rut)
         while j < idx.shape[0] and idx[j] == i:
             out[j, :] = rut
             j += 1
@@ -155,7 +166,8 @@ def remember_sinkage(m, w):
         return
     for b in range(w.sink.shape[0]):
         if w.sink[b] > 0.0:
-            raise_memory(w.apos[b, 0], w.sink[b], m.par[P_RUT_X0], m.par[P_RUT_DX], m.rut)
+            raise_memory(w.apos[b, 0], w.sink[b], m.par[P_RUT_X0], m.par[P_RUT_DX], 0.5 * m.par[P_LINK_LENGTH],
+                         m.rut)
             if m.touchdown[b, 0] != m.touchdown[b, 0]:
                 m.touchdown[b, 0] = w.apos[b, 0]
                 m.touchdown[b, 1] = w.apos[b, 1]

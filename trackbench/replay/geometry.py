@@ -362,7 +362,7 @@ def running_sinkage(ds, idx, edges):
     """Deepest sinkage so far along the rut: (len(idx), k) at the frames idx (sorted), and
     (k,) after the last sample of the run, at the centres of the cells between edges. The
     soil's own rule raises its memory (model.soil_force.raise_memory: nodes at the cell
-    centres, raised just enough under each sunk pin); here it is replayed on the pins'
+    centres, raised under each sunk pin's shoe); here it is replayed on the pins'
     output samples instead of after every step."""
     from ..model.soil_force import replay_memory
     k = len(edges) - 1
@@ -373,7 +373,8 @@ def running_sinkage(ds, idx, edges):
     px = np.ascontiguousarray(ds.variables["pin_x"].values, dtype=float)
     sink = np.ascontiguousarray(ds.variables["sinkage"].values, dtype=float)
     dx = float(edges[1] - edges[0])
-    last = replay_memory(px, sink, float(edges[0]), dx, idx, out)
+    half = 0.5 * float(json.loads(ds.attrs["scenario"])["track"]["link_length"])
+    last = replay_memory(px, sink, float(edges[0]), dx, half, idx, out)
     return out, last
 
 
