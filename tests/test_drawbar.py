@@ -101,7 +101,9 @@ def test_thrust_against_slip_matches_wong_within_5_percent(slip, duration, since
     slip by the towing rig, against Wong's closed form at the slip the soil sees
     (traction.track_slip), over the pins' own pressures (each pin's Bekker share of the
     weight, traction.pressure_effect; the road wheels load the pins under them most): within
-    5 %, and steady: thrust / W alike (5 %) over the two halves of the window (W swings with
+    3 % (measured: 2 % at most over runs nudged by 1e-9 m). That holds the model's shear to
+    Wong's theory for the pressures the model itself finds, not those to an outside figure
+    (the uniform form below does that), and steady: thrust / W alike (5 %) over the two halves of the window (W swings with
     the vehicle's bounce at high slip, the thrust with it; a thrust still settling, as with
     the paper's links, rises 10-60 % from one half to the next). The rig holds the
     sprocket's slip to 0.02 of the set one, and the drawbar takes the thrust (steady: the
@@ -114,11 +116,11 @@ def test_thrust_against_slip_matches_wong_within_5_percent(slip, duration, since
     assert fig["slip"] == pytest.approx(slip, abs=0.02)
     assert fig["drawbar_load"] == pytest.approx(fig["thrust"], rel=0.03)
     assert halves[1] == pytest.approx(halves[0], rel=0.05)
-    assert fig["thrust"] == pytest.approx(f_own, rel=0.05)
+    assert fig["thrust"] == pytest.approx(f_own, rel=0.03)
 
 
 @pytest.mark.parametrize("slip, duration, since", [
-    pytest.param(*RUNS[0], marks=pytest.mark.xfail(strict=True, reason=(
+    pytest.param(*RUNS[0], marks=pytest.mark.xfail(strict=True, raises=AssertionError, reason=(
         "at 5 % slip set (2 % at the soil) the thrust is 6.4 % above Wong's form for a uniformly loaded track "
         "(five runs nudged by 1e-9 m: +5.6 to +6.5 %): the road wheels load the pins under them most, and "
         "Wong's integral over the pins' own pressures is 8.1 % above the uniform one; the thrust is within "

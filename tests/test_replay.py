@@ -543,10 +543,13 @@ def _raise_nodes(rut, x, z, x0, dx, half):
     node under the pin's shoe (within half a link of x) to z where it is shallower."""
     u = (x - x0) / dx - 0.5
     c = int(np.floor(u))
+    around = 0 <= c and c + 1 < rut.size         # else x has no two nodes around it: all under the shoe
     centres = x0 + (np.arange(rut.size) + 0.5) * dx
-    shoe = (np.abs(centres - x) <= half) & (np.arange(rut.size) != c) & (np.arange(rut.size) != c + 1)
+    shoe = np.abs(centres - x) <= half
+    if around:
+        shoe[c:c + 2] = False
     rut[shoe] = np.maximum(rut[shoe], z)
-    if c < 0 or c + 1 >= rut.size:
+    if not around:
         return
     u -= c
     w = u * u * u * (10.0 + u * (6.0 * u - 15.0))
@@ -558,6 +561,22 @@ def _raise_nodes(rut, x, z, x0, dx, half):
     lo, hi = (c, c + 1) if rut[c] <= rut[c + 1] else (c + 1, c)
     w_lo = 1 - w if lo == c else w
     rut[lo] = min(max((z - (1 - w_lo) * rut[hi]) / w_lo, rut[lo]), rut[hi])
+
+
+def test_soil_memory_under_a_shoe_at_both_ends_of_the_cells():
+    """The kernel's rule (model.soil_force.raise_memory, through replay_memory) against the
+    rebuild above, pins near and beyond both ends of a small row of cells: every node under
+    the shoe is raised, at either end alike."""
+    from trackbench.model.soil_force import replay_memory
+    x0, dx, n, half = 0.0, 0.01, 30, 0.095
+    for x in (-0.071, -0.004, 0.002, 0.013, 0.151, 0.287, 0.296, 0.305, 0.331):   # none half a shoe from a centre
+        px, sink = np.array([[x]]), np.array([[0.05]])
+        got = replay_memory(px, sink, x0, dx, half, np.array([0]), np.zeros((1, n)))
+        want = np.zeros(n)
+        _raise_nodes(want, x, 0.05, x0, dx, half)
+        np.testing.assert_array_equal(got, want)
+        under = np.abs(x0 + (np.arange(n) + 0.5) * dx - x) <= half
+        assert (got[under] == 0.05).all() and (got[~under] == 0.0).all()
 
 
 def test_soil_dent_matches_an_independent_rebuild(soil_run):

@@ -1,6 +1,6 @@
 """What the command tells the workers' fork server to warm (preload.py), and where the
 server says that it compiles: the one protocol both sides share, light enough for the
-command to import (no numba, no numpy)."""
+command to import (no numba)."""
 
 import os
 from pathlib import Path
