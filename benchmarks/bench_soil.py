@@ -32,7 +32,7 @@ def soils(speed=5.0, duration=1.0):
         late = ds.time.values > 0.5 * duration
         print(f"{soil}: {ds.attrs['status']}, solve {ds.attrs['solve_time']:.1f} s; second half: speed "
               f"{ds.chassis_vx.values[late].mean():.3f} m/s, drawbar pull {ds.drawbar_pull.values[late].mean() / 1e3:.1f} "
-              f"kN, slip {np.nanmean(ds.slip.values[late]):.3f}, sinkage max {float(ds.sinkage.max()) * 100:.1f} cm, "
+              f"kN, slip {float(ds.mean_slip):.3f}, sinkage max {float(ds.sinkage.max()) * 100:.1f} cm, "
               f"deepest rut {float(ds.rut_depth.max()) * 100:.1f} cm; energy residual "
               f"{float(abs(ds.energy_residual).max()):.1e}")
 

@@ -144,6 +144,7 @@ def _fake_soil_run(path, slip, pull):
     pin_x = np.array([0.4, 0.2, 0.0, -0.2]) - 4.0 * slip / (1.0 - slip) * t[:, None]   # track slip = slip
     sc = {"terrain": {"kind": "flat", "soil": "lete_sand"}, "track": {"link_length": 0.19, "width": 0.5}}
     ds = xr.Dataset({"slip": ("time", np.full(t.size, slip)), "chassis_vx": ("time", np.full(t.size, 4.0)),
+                     "sprocket_speed": ("time", np.full(t.size, 4.0 / (1.0 - slip) / 0.3)),   # pitch radius 0.3
                      "drawbar_pull": ("time", np.full(t.size, pull)),
                      "drawbar_load": ("time", np.full(t.size, pull)), "sprocket_torque": ("time", np.full(t.size, 1e4)),
                      "ground_force_y": ("time", np.full(t.size, 2e5)), "sinkage": (("time", "pin"), sink),

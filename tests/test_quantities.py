@@ -1,7 +1,10 @@
 """The summary quantities are one table (trackbench/quantities.py): every place that shows
 or stores a run's summary reads it, and it matches the Dataset."""
 
+import json
+
 import pandas as pd
+import pytest
 
 from trackbench import output, quantities
 from trackbench.replay.plots import study_axes
@@ -50,7 +53,9 @@ def test_the_soil_quantities_match_their_dataset():
     assert v["peak_sinkage"] >= float(ds.sinkage.max()) > 0.0
     late = ds.time.values >= 0.025
     assert v["mean_drawbar_pull"] == float(ds.drawbar_pull[late].mean())
-    assert v["mean_slip"] == float(np.nanmean(ds.slip.values[late]))
+    rp = json.loads(ds.attrs["closed_layout"])["pitch_radius"]
+    travelled, laid = ds.chassis_vx.values[late].mean(), (ds.sprocket_speed.values[late] * rp).mean()
+    assert v["mean_slip"] == pytest.approx(1.0 - travelled / laid, rel=1e-12)
     assert "mean_slip" in quantities.peak_columns(5, features={"soil"})
     assert "peak_sinkage" not in quantities.summary_columns(5, features={"closed"})
 

@@ -225,9 +225,9 @@ def _soil(model, result, ground, placed):
         with np.errstate(divide="ignore", invalid="ignore"):
             slip = np.where(np.abs(track) > 1e-3, 1.0 - qd[:, L.Q_X] / track, np.nan)
         v["slip"] = _var(T, slip, "1", "slip: 1 - chassis speed / (sprocket speed x pitch radius)")
-        with np.errstate(invalid="ignore"):
-            v["mean_slip"] = _var((), float(np.nanmean(slip[late])) if np.isfinite(slip[late]).any() else np.nan,
-                                  "1", "slip, mean over the run's second half")
+        from .traction import mean_slip
+        v["mean_slip"] = _var((), mean_slip(qd[late, L.Q_X], track[late]), "1", "slip over the run's second half: "
+                              "1 - distance travelled / track laid by the sprocket")
     return {**v, "sinkage": _var(P, sink, "m", "pin's sinkage below the soil surface (0 off the soil)"),
             "rut_depth": _var(("rut_x",), plastic[lo:hi], "m", "plastic sinkage the soil keeps at the end of "
                               "the run (the rut), along x"),
