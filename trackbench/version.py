@@ -2,4 +2,4 @@
 model or the solvers changes results: study run ids include it)."""
 
 __version__ = "0.1.0"
-MODEL_VERSION = "1"
+MODEL_VERSION = "2"
