@@ -120,6 +120,20 @@ def test_force_reruns_everything(tmp_path):
     assert set(after) == set(before) and all(after[k] != before[k] for k in after)
 
 
+def test_runs_of_an_edited_grid_are_kept_and_said(tmp_path):
+    """A grid edited (or a new model version: run ids include it) leaves run folders that belong
+    to no run of the study: kept, not in the summary, and the report says how many."""
+    from trackbench.study.runner import report
+    p = tmp_path / "g.toml"
+    p.write_text(f"[study]\nname = 'g'\n[scenario]\n{FAST}[grid]\nspeed = [6.0, 9.0]\n")
+    first = run_study(p, workers=1, output=tmp_path / "out", quiet=True)
+    assert first.others == 0 and "other run folder" not in report(first)
+    p.write_text(f"[study]\nname = 'g'\n[scenario]\n{FAST}[grid]\nspeed = [9.0]\n")
+    second = run_study(p, workers=1, output=tmp_path / "out", quiet=True)
+    assert second.skipped == 1 and second.others == 1 and len(second.summary) == 1
+    assert "1 other run folder in " in report(second) and len(list((tmp_path / "out" / "runs").iterdir())) == 2
+
+
 def test_failed_run_is_isolated_and_reported(tmp_path):
     p = tmp_path / "fail.toml"
     p.write_text(f"[study]\nname = 'fail'\n[scenario]\n{FAST}"

@@ -26,6 +26,7 @@ class Outcome:
     replicates: object = None                       # DataFrame or None
     elapsed: float = 0.0
     summary_error: str = ""                         # why summary.csv could not be written
+    others: int = 0                                 # run folders of no run of this study (kept)
 
     def counts(self):
         """(failed, not run) over the study's runs: the summary's view, plus the runs failed in
@@ -247,6 +248,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
             warming.compile_flag().unlink(missing_ok=True)
             store.clean_tmp(study.output)  # what killed workers left half-written
             _summarise(study, out)
+            out.others = len(other_runs(study))
     out.elapsed = time.perf_counter() - t0
     return out
 
@@ -322,6 +324,14 @@ def _files_problem(rdir, disk, own, rec):
     return None
 
 
+def other_runs(study):
+    """Run folders in the study folder that belong to none of its runs (a grid edited since, or
+    an older model version: run ids include it). Kept, never in the summary."""
+    ids = {r.run_id for r in study.runs}
+    runs = Path(study.output) / "runs"
+    return sorted(p.name for p in runs.iterdir() if p.is_dir() and p.name not in ids) if runs.is_dir() else []
+
+
 def status_counts(study):
     """{'completed': n, 'failed': n, 'pending': n} from the runs' run.json."""
     df = summary_frame(study)
@@ -338,4 +348,7 @@ def report(outcome):
              f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
     if outcome.summary_error:
         text += f" NOT WRITTEN: {outcome.summary_error}"
+    if outcome.others:
+        text += (f"\n{outcome.others} other run folder{'s' if outcome.others > 1 else ''} in {s.output}/runs "
+                 "(an earlier grid or model version) kept, not in the summary")
     return text
