@@ -131,7 +131,10 @@ def test_runs_of_an_edited_grid_are_kept_and_said(tmp_path):
     p.write_text(f"[study]\nname = 'g'\n[scenario]\n{FAST}[grid]\nspeed = [9.0]\n")
     second = run_study(p, workers=1, output=tmp_path / "out", quiet=True)
     assert second.skipped == 1 and second.others == 1 and len(second.summary) == 1
+    assert "study g: 1 run, 0 run now, 1 already completed" in report(second)
     assert "1 other run folder in " in report(second) and len(list((tmp_path / "out" / "runs").iterdir())) == 2
+    r = cli(["study", "status", str(tmp_path / "out")], tmp_path)
+    assert r.returncode == 0 and "study g: 1 run: 1 done, 0 failed, 0 pending" in r.stdout and "1 other run folder kept" in r.stdout
 
 
 def test_failed_run_is_isolated_and_reported(tmp_path):

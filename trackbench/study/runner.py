@@ -344,7 +344,8 @@ def report(outcome):
     text = format_table(outcome.summary, outcome.replicates, s.param_names)
     n_failed, n_missing = outcome.counts()
     missing = f", {n_missing} not run" if n_missing else ""
-    text += (f"\n\nstudy {s.name}: {len(s.runs)} runs, {outcome.ran} run now, {outcome.skipped} already completed, "
+    n = len(s.runs)
+    text += (f"\n\nstudy {s.name}: {n} run{'' if n == 1 else 's'}, {outcome.ran} run now, {outcome.skipped} already completed, "
              f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
     if outcome.summary_error:
         text += f" NOT WRITTEN: {outcome.summary_error}"
