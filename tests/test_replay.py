@@ -571,7 +571,7 @@ def test_soil_memory_under_a_shoe_at_both_ends_of_the_cells():
     x0, dx, n, half = 0.0, 0.01, 30, 0.095
     for x in (-0.071, -0.004, 0.002, 0.013, 0.151, 0.287, 0.296, 0.305, 0.331):   # none half a shoe from a centre
         px, sink = np.array([[x]]), np.array([[0.05]])
-        got = replay_memory(px, sink, x0, dx, half, np.array([0]), np.zeros((1, n)))
+        got = replay_memory(px, sink, x0, dx, 2 * half, np.array([0]), np.zeros((1, n)))
         want = np.zeros(n)
         _raise_nodes(want, x, 0.05, x0, dx, half)
         np.testing.assert_array_equal(got, want)

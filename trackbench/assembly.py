@@ -92,8 +92,9 @@ def initial_state(scenario: Scenario, eq):
     nw = scenario["vehicle.n_wheels"]
     off = L.pin_offset(nw)
     y0[nq + L.Q_X] = scenario["speed"]
-    end = off + 2 * scenario["track.n_links"] if _closed(scenario) else nq
-    if _closed(scenario):
+    closed = _closed(scenario)
+    end = off + 2 * scenario["track.n_links"] if closed else nq
+    if closed:
         _loop_velocities(scenario, eq, y0)
     else:
         y0[nq + off:2 * nq:2] = scenario["speed"]

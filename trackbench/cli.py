@@ -157,24 +157,19 @@ def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or it
     typer.echo(format_table(df, rep, study.param_names))
 
 
-def _runs(n):
-    return f"{n} run" if n == 1 else f"{n} runs"
-
-
 @study_app.command("status", cls=_Command)
 def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
     """Show how many runs are done, failed and pending."""
-    from .study.runner import other_runs, status_counts
+    from .study.runner import count, other_runs, others_note, status_counts
     from .study.summary import missing_folder
     study = _study_folder_or_fail(file)[0] if file.is_dir() else _load_study_or_fail(file)
     if not study.output.is_dir():
-        typer.echo(f"study {study.name}: {_runs(len(study.runs))}, all pending: {missing_folder(study)}")
+        typer.echo(f"study {study.name}: {count(len(study.runs), 'run')}, all pending: {missing_folder(study)}")
         return
     counts, df = status_counts(study)
-    others = len(other_runs(study))
-    kept = f"; {others} other run folder{'s' if others > 1 else ''} kept (an earlier grid or model version)" if others else ""
-    typer.echo(f"study {study.name}: {_runs(len(study.runs))}: {counts['completed']} done, {counts['failed']} failed, "
-               f"{counts['pending']} pending ({study.output}){kept}")
+    kept = others_note(len(other_runs(study)))
+    typer.echo(f"study {study.name}: {count(len(study.runs), 'run')}: {counts['completed']} done, {counts['failed']} failed, "
+               f"{counts['pending']} pending ({study.output}){'; ' + kept if kept else ''}")
     for _, r in df[df.status == "failed"].iterrows():
         typer.echo(f"  failed {r.run_id}: {r.status_message}")
 

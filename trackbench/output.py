@@ -222,10 +222,8 @@ def _soil(model, result, ground, placed):
                                    "second half")}
     if model.closed:
         track = -qd[:, L.q_sprocket(model.nw, model.n_links)] * model.arrays.loop[L.LP_PITCH_RADIUS]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            slip = np.where(np.abs(track) > 1e-3, 1.0 - qd[:, L.Q_X] / track, np.nan)
-        v["slip"] = _var(T, slip, "1", "slip: 1 - chassis speed / (sprocket speed x pitch radius)")
-        from .traction import mean_slip
+        from .traction import mean_slip, slip
+        v["slip"] = _var(T, slip(qd[:, L.Q_X], track), "1", "slip: 1 - chassis speed / (sprocket speed x pitch radius)")
         v["mean_slip"] = _var((), mean_slip(qd[late, L.Q_X], track[late]), "1", "slip over the run's second half: "
                               "1 - distance travelled / track laid by the sprocket")
     return {**v, "sinkage": _var(P, sink, "m", "pin's sinkage below the soil surface (0 off the soil)"),

@@ -27,6 +27,17 @@ import numpy as np
 from .model.soil import bekker_pressure, janosi_shear, resolve_soil, static_sinkage, wong_thrust
 
 
+TRACK_STILL = 1e-3      # m/s: slower than this, the sprocket lays no track and there is no slip
+
+
+def slip(chassis_speed, track_speed):
+    """1 - chassis speed / track speed (the sprocket's speed x pitch radius), sample by sample;
+    NaN where the track stands still."""
+    track = np.asarray(track_speed, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(np.abs(track) > TRACK_STILL, 1.0 - np.asarray(chassis_speed) / track, np.nan)
+
+
 def mean_slip(chassis_speed, track_speed):
     """The slip over a stretch of run: 1 - distance travelled / track laid, the ratio of the
     means (NaN without track laid). Not the mean of the instantaneous slip: on soil the
@@ -34,7 +45,7 @@ def mean_slip(chassis_speed, track_speed):
     and the samples where it lags weigh that mean down (-5 % against +7 % on a run of the
     soft_soil study)."""
     track = float(np.mean(track_speed)) if len(track_speed) else 0.0
-    return 1.0 - float(np.mean(chassis_speed)) / track if abs(track) > 1e-3 else float("nan")
+    return 1.0 - float(np.mean(chassis_speed)) / track if abs(track) > TRACK_STILL else float("nan")
 
 
 def run_soil(ds):

@@ -100,19 +100,20 @@ def soil_kink(x, z, kink, par, rut):
 
 
 @njit(**INLINE)
-def raise_memory(x, z, x0, dx, half, rut):
+def raise_memory(x, z, x0, dx, shoe, rut):
     """A pin at x sunk by z stands for a shoe of its link's length: the soil under the whole
     shoe is pressed to z. The nodes around x are raised, never lowered, just enough that z_m
     at x becomes z (when z is deeper): both to z if z is deeper than both, else only the
-    shallower one; every other node within `half` of x (the shoe's half length) to z where
-    it is shallower (beyond the nodes' ends, x has no two nodes around it: every node
-    within `half`). No node ends deeper than the deeper of its old value and a sinkage
+    shallower one; every other node within half the shoe's length `shoe` (the link length)
+    of x to z where it is shallower (beyond the nodes' ends, x has no two nodes around it:
+    every node within that half). No node ends deeper than the deeper of its old value and a sinkage
     reached within half a shoe (or a cell) of it: a sliding pin leaves the sinkage it
     reached, not more. Raising one shoe moves the memory under no other sunk pin while
     sunk pins stay more than half a link and a cell apart along x (links less steep than
     ~55 deg; on paper_step on LETE sand the closest were 0.14 m apart against 0.105 m)."""
     n = rut.shape[0]
     c, wr = rut_nodes(x, x0, dx, n)
+    half = 0.5 * shoe
     lo_i = max(int(math.ceil((x - half - x0) / dx - 0.5)), 0)
     hi_i = min(int(math.floor((x + half - x0) / dx - 0.5)), n - 1)
     for i in range(lo_i, hi_i + 1):
@@ -130,9 +131,9 @@ def raise_memory(x, z, x0, dx, half, rut):
 
 
 @njit(**KERNEL)
-def replay_memory(px, sink, x0, dx, half, idx, out):
+def replay_memory(px, sink, x0, dx, shoe, idx, out):
     """The memory rebuilt from output samples (pin x and sinkage per sample), raised by the
-    rule above (shoes of half length `half`) at each sample instead of after each step:
+    rule above (shoes `shoe` long) at each sample instead of after each step:
     out[j] = the nodes after sample idx[j] (idx sorted). Returns the nodes after the last
     sample."""
     rut = np.zeros(out.shape[1])
@@ -140,7 +141,7 @@ def replay_memory(px, sink, x0, dx, half, idx, out):
     for i in range(px.shape[0]):
         for b in range(px.shape[1]):
             if sink[i, b] > 0.0:
-                raise_memory(px[i, b], sink[i, b], x0, dx, half, rut)
+                raise_memory(px[i, b], sink[i, b], x0, dx, shoe, rut)
         while j < idx.shape[0] and idx[j] == i:
             out[j, :] = rut
             j += 1
@@ -168,8 +169,7 @@ def remember_sinkage(m, w):
         return
     for b in range(w.sink.shape[0]):
         if w.sink[b] > 0.0:
-            raise_memory(w.apos[b, 0], w.sink[b], m.par[P_RUT_X0], m.par[P_RUT_DX], 0.5 * m.par[P_LINK_LENGTH],
-                         m.rut)
+            raise_memory(w.apos[b, 0], w.sink[b], m.par[P_RUT_X0], m.par[P_RUT_DX], m.par[P_LINK_LENGTH], m.rut)
             if m.touchdown[b, 0] != m.touchdown[b, 0]:
                 m.touchdown[b, 0] = w.apos[b, 0]
                 m.touchdown[b, 1] = w.apos[b, 1]

@@ -373,8 +373,8 @@ def running_sinkage(ds, idx, edges):
     px = np.ascontiguousarray(ds.variables["pin_x"].values, dtype=float)
     sink = np.ascontiguousarray(ds.variables["sinkage"].values, dtype=float)
     dx = float(edges[1] - edges[0])
-    half = 0.5 * float(scenario_of(ds)["track"]["link_length"])
-    last = replay_memory(px, sink, float(edges[0]), dx, half, idx, out)
+    shoe = float(scenario_of(ds)["track"]["link_length"])
+    last = replay_memory(px, sink, float(edges[0]), dx, shoe, idx, out)
     return out, last
 
 

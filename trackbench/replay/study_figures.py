@@ -53,16 +53,20 @@ MAX_LINES = 6        # one line per value of the other axes up to this many, els
 _STYLES = [("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1, 1, 1)), "v"), ((0, (1, 3)), "P")]
 
 
+def _manifest(src):
+    """The study's runs.json beside its summary ({} without one)."""
+    from ..study.store import read_json
+    return read_json(src.parent / "runs.json") or {}
+
+
 def _study_name(src):
     """The study's own name (runs.json), not its results folder's, which --output may have set."""
-    from ..study.store import read_json
-    return (read_json(src.parent / "runs.json") or {}).get("name") or src.parent.name
+    return _manifest(src).get("name") or src.parent.name
 
 
 def _run_scenarios(src):
     """run id -> resolved scenario, from the study's runs.json ({} without one)."""
-    from ..study.store import read_json
-    runs = (read_json(src.parent / "runs.json") or {}).get("runs") or []
+    runs = _manifest(src).get("runs") or []
     return {str(r.get("run_id")): r.get("scenario") or {} for r in runs}
 
 
@@ -200,14 +204,15 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
     return fig
 
 
-# the panels beyond the forces, each alone in its own unit, and what the title calls them
-_OWN_PANELS = {"peak_sprocket_torque": "sprocket torque", "peak_sinkage": "sinkage",
-               "mean_drawbar_pull": "drawbar pull", "mean_slip": "slip"}
+# the panels beyond the forces, each alone in its own unit: what the title calls them, and the
+# y label where the quantity's own label is too long for the panel's height (None: its own)
+_OWN_PANELS = {"peak_sprocket_torque": ("sprocket torque", "peak sprocket torque"), "peak_sinkage": ("sinkage", None),
+               "mean_drawbar_pull": ("drawbar pull", None), "mean_slip": ("slip", None)}
 
 
 def _what(panels):
     """The figure title's list of what it shows: 'peak forces, sprocket torque and slip'."""
-    own = [_OWN_PANELS[cols[0]] for _, cols, _ in panels if cols and cols[0] in _OWN_PANELS]
+    own = [_OWN_PANELS[cols[0]][0] for _, cols, _ in panels if cols and cols[0] in _OWN_PANELS]
     names = ["peak forces"] + own
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
 
@@ -222,11 +227,10 @@ def _panels(df):
     panels = [("peak vertical wheel-track force (kN)", _wheel_columns(df), 1e3)]
     if forces:
         panels.append(("peak force (kN)", forces, 1e3))
-    for name in _OWN_PANELS:
+    for name, (_, label) in _OWN_PANELS.items():
         if name in df.columns and df[name].notna().any():
             q = BY_NAME[name]
-            label = "peak sprocket torque" if name == "peak_sprocket_torque" else q.label  # fits the panel's height
-            panels.append((f"{label} ({q.unit})", [name], q.per_unit))
+            panels.append((f"{label or q.label} ({q.unit})", [name], q.per_unit))
     return panels
 
 

@@ -324,6 +324,17 @@ def _files_problem(rdir, disk, own, rec):
     return None
 
 
+def count(n, word):
+    """'1 run', '2 runs'."""
+    return f"{n} {word}" if n == 1 else f"{n} {word}s"
+
+
+def others_note(n, where=""):
+    """What a study says of the run folders that belong to none of its runs ('' for none)."""
+    place = f" in {where}" if where else ""
+    return f"{count(n, 'other run folder')}{place} kept (an earlier grid or model version)" if n else ""
+
+
 def other_runs(study):
     """Run folders in the study folder that belong to none of its runs (a grid edited since, or
     an older model version: run ids include it). Kept, never in the summary."""
@@ -344,12 +355,10 @@ def report(outcome):
     text = format_table(outcome.summary, outcome.replicates, s.param_names)
     n_failed, n_missing = outcome.counts()
     missing = f", {n_missing} not run" if n_missing else ""
-    n = len(s.runs)
-    text += (f"\n\nstudy {s.name}: {n} run{'' if n == 1 else 's'}, {outcome.ran} run now, {outcome.skipped} already completed, "
+    text += (f"\n\nstudy {s.name}: {count(len(s.runs), 'run')}, {outcome.ran} run now, {outcome.skipped} already completed, "
              f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
     if outcome.summary_error:
         text += f" NOT WRITTEN: {outcome.summary_error}"
     if outcome.others:
-        text += (f"\n{outcome.others} other run folder{'s' if outcome.others > 1 else ''} in {s.output}/runs "
-                 "(an earlier grid or model version) kept, not in the summary")
+        text += f"\n{others_note(outcome.others, f'{s.output}/runs')}, not in the summary"
     return text
