@@ -69,13 +69,14 @@ def _loop_velocities(scenario, eq, y0):
     """The closed track moving at `speed` without slip on the ground: every pin runs round
     the loop (clockwise, along its neighbours' chord) at `speed` relative to the chassis,
     the sprocket turns to match."""
+    from .model import fixed_math as fm    # numba: loaded when first needed
     nq = eq.q.size
     nw, n = scenario["vehicle.n_wheels"], scenario["track.n_links"]
     v = scenario["speed"]
     off = L.pin_offset(nw)
     pins = eq.q[off:off + 2 * n].reshape(n, 2)
     chord = np.roll(pins, -1, axis=0) - np.roll(pins, 1, axis=0)
-    rel = v * chord / np.hypot(*chord.T)[:, None]
+    rel = v * chord / fm.vhypot(*chord.T)[:, None]
     y0[nq + off:nq + off + 2 * n] = (rel + [v, 0.0]).ravel()
     g = closed_parts(scenario)[0]
     y0[nq + L.q_sprocket(nw, n)] = -v / g.pitch_radius
@@ -110,6 +111,7 @@ RUT_CELLS_MAX = 2_000_000
 
 def soil_par(scenario):
     """{P_* index: value} of the scenario's soft soil, {} on rigid ground."""
+    from .model import fixed_math as fm    # numba: loaded when first needed
     from .model.soil import resolve_soil
     soil = resolve_soil(scenario["terrain"].get("soil", "rigid"))
     if soil is None:
@@ -118,7 +120,7 @@ def soil_par(scenario):
     area = b * scenario["track.link_length"]
     return {L.P_SOIL: 1.0, L.P_SOIL_N: soil["n"], L.P_SOIL_K: soil["k_c"] / b + soil["k_phi"],
             L.P_SOIL_KE: soil["unloading_stiffness"], L.P_PIN_AREA: area, L.P_SOIL_COHESION: soil["cohesion"] * area,
-            L.P_SOIL_TAN_PHI: float(np.tan(np.radians(soil["friction_angle"]))),
+            L.P_SOIL_TAN_PHI: float(fm.vtan(np.radians(soil["friction_angle"]))),
             L.P_SOIL_SHEAR_K: soil["shear_modulus"]}
 
 

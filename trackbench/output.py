@@ -12,7 +12,8 @@ from .model import layout as L
 from .model.energy import paper_balance, work_residual
 from .model.kinematics import place_samples
 from .status import Result
-from .version import MODEL_VERSION, __version__
+from .version import MODEL_VERSION, __version__, toolchain
+from .model import fixed_math as fm
 
 
 
@@ -141,11 +142,11 @@ def _span_links(on_teeth, mid_y):
 def _span_tensions(model, q, pins, tension, g):
     """Tension of the upper and of the lower span where they leave the sprocket (_span_links;
     NaN where the loop does not leave the teeth at exactly two places)."""
-    c, s = np.cos(q[:, L.Q_PITCH]), np.sin(q[:, L.Q_PITCH])
+    c, s = fm.vcos(q[:, L.Q_PITCH]), fm.vsin(q[:, L.Q_PITCH])
     sx, sy = g.sprocket
     ax = q[:, L.Q_X] + c * sx - s * sy
     ay = q[:, L.Q_Y] + s * sx + c * sy
-    r = np.hypot(pins[:, :, 0] - ax[:, None], pins[:, :, 1] - ay[:, None])
+    r = fm.vhypot(pins[:, :, 0] - ax[:, None], pins[:, :, 1] - ay[:, None])
     on_teeth = r < g.tip_radius + model.arrays.loop[L.LP_PIN_RADIUS]
     mid_y = 0.5 * (pins[:, :, 1] + np.roll(pins[:, :, 1], 1, axis=1))
     links = _span_links(on_teeth, mid_y)
@@ -205,7 +206,7 @@ def _soil(model, result, ground, placed):
     s = (px - seg[k, L.SEG_X0]) * seg[k, L.SEG_NX] + (py - seg[k, L.SEG_Y0]) * seg[k, L.SEG_NY]
     sink = np.maximum(par[L.P_PAD_GROUND] - s, 0.0)
     x = par[L.P_RUT_X0] + (np.arange(rut.size) + 0.5) * par[L.P_RUT_DX]
-    plastic = np.maximum(rut - par[L.P_SOIL_K] * rut ** par[L.P_SOIL_N] / par[L.P_SOIL_KE], 0.0)
+    plastic = np.maximum(rut - par[L.P_SOIL_K] * fm.vpow(rut, par[L.P_SOIL_N]) / par[L.P_SOIL_KE], 0.0)
     used = np.flatnonzero(rut > 0.0)
     lo, hi = (used[0], used[-1] + 1) if used.size else (0, 0)
     pull = d[:, L.D_GROUND_FX]
@@ -264,6 +265,7 @@ def _attrs(scenario, model, eq, ground, resolved, st, wall_time, solve_time):
         "title": f"trackbench run: {scenario.name}",
         "trackbench_version": __version__,
         "model_version": MODEL_VERSION,
+        "toolchain": toolchain(),
         "status": "completed" if status == Result.SUCCESSFUL else "failed",
         "status_code": int(status),
         "status_message": status.message,

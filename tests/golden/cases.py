@@ -1,9 +1,13 @@
 """The runs whose every output array is pinned bit for bit (tests/test_golden.py) and the
 script that records their hashes: `python tests/golden/cases.py > tests/golden/hashes.json`.
-Record only when a change is meant to change results, and say so in CHANGELOG.md."""
+Record only when a change is meant to change results, and say so in CHANGELOG.md.
+`python tests/golden/cases.py --check` compares instead: one line per case that differs,
+exit status 1 (the test that runs it under other CPU kernels reads it)."""
 
 import hashlib
 import json
+import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -17,7 +21,7 @@ CASES = {
 }
 
 # attributes that vary from run to run (timings) or name the code, not the numbers
-VOLATILE = {"wall_time", "solve_time", "trackbench_version"}
+VOLATILE = {"wall_time", "solve_time", "trackbench_version", "toolchain"}
 
 
 def digest(a):
@@ -37,6 +41,28 @@ def simulate_case(name):
     return tb.simulate(tb.Scenario.from_dict(CASES[name]))
 
 
+def differences(name, ds, expected):
+    """The arrays and attributes of a case that differ from the recorded hashes."""
+    got = json.loads(json.dumps(fingerprint(ds), default=str))
+    want = expected[name]
+    arrays = sorted(k for k in set(want) | set(got) if k != "attrs" and want.get(k) != got.get(k))
+    attrs = sorted(k for k in set(want["attrs"]) | set(got["attrs"]) if want["attrs"].get(k) != got["attrs"].get(k))
+    return arrays, [f"{k}: {want['attrs'].get(k)!r} -> {got['attrs'].get(k)!r}" for k in attrs]
+
+
+def check():
+    expected = json.loads((Path(__file__).parent / "hashes.json").read_text())
+    bad = 0
+    for name in sorted(CASES):
+        arrays, attrs = differences(name, simulate_case(name), expected)
+        if arrays or attrs:
+            bad += 1
+            print(f"{name}: arrays changed: {arrays}; attributes changed: {attrs}")
+    return 1 if bad else 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--check"]:
+        sys.exit(check())
     print(json.dumps({name: fingerprint(simulate_case(name)) for name in CASES}, indent=1, sort_keys=True,
                      default=str))

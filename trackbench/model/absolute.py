@@ -27,6 +27,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import fixed_math as fm
 from .jit import BORROW, INLINE
 from .kernels import track_loads
 from .kinematics import body_offset, wheel_offset
@@ -60,16 +61,14 @@ def from_reduced(y, par, arms, z, zd):
     la = par[P_ARM_LENGTH]
     th = y[Q_PITCH]
     om = y[nq + Q_PITCH]
-    c = math.cos(th)
-    s = math.sin(th)
+    s, c = fm.sincos(th)
     for k in (Z_X, Z_Y, Z_PITCH):   # the chassis coordinates are the same in both
         z[k] = y[k]
         zd[k] = y[nq + k]
     for i in range(nw):
         beta = th + y[Q_ARM + i]
         bd = om + y[nq + Q_ARM + i]
-        cb = math.cos(beta)
-        sb = math.sin(beta)
+        sb, cb = fm.sincos(beta)
         rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
         px, py = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])   # the pivot
         j = z_arm(i)
@@ -110,13 +109,12 @@ def joint_vectors(z, par, arms, geo):
     """Per joint i: geo[i] = (r_x, r_y, l cos beta, l sin beta) with r = R(theta) p_i.
     Then dr_i = (-r_y, r_x) and d(l e_i)/d beta = (-l sin beta, l cos beta)."""
     la = par[P_ARM_LENGTH]
-    c = math.cos(z[Z_PITCH])
-    s = math.sin(z[Z_PITCH])
+    s, c = fm.sincos(z[Z_PITCH])
     for i in range(arms.shape[0]):
         geo[i, GEO_RX], geo[i, GEO_RY] = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
         beta = z[z_arm(i) + ZA_BETA]
-        geo[i, GEO_LX] = la * math.cos(beta)
-        geo[i, GEO_LY] = la * math.sin(beta)
+        geo[i, GEO_LX] = la * fm.cos(beta)
+        geo[i, GEO_LY] = la * fm.sin(beta)
 
 
 @njit(**BORROW)
@@ -193,8 +191,7 @@ def _place_absolute(z, zd, ends, w):
     apos, avel, wc, wv = w.apos, w.avel, w.wc, w.wv
     n_pins = apos.shape[0]
     nb = z_pin(wc.shape[0])
-    c = math.cos(z[Z_PITCH])
-    s = math.sin(z[Z_PITCH])
+    s, c = fm.sincos(z[Z_PITCH])
     for i in range(wc.shape[0]):
         j = z_arm(i)
         wc[i, 0] = z[j + ZA_X]
@@ -274,8 +271,7 @@ def contact_power(z, zd, ends, fc, fw, nw):
     sum track_loads forms for D_POWER (pins 0 and n_links move with the chassis)."""
     n_pins = fc.shape[0]
     nb = z_pin(nw)
-    c = math.cos(z[Z_PITCH])
-    s = math.sin(z[Z_PITCH])
+    s, c = fm.sincos(z[Z_PITCH])
     p = 0.0
     for e in range(2):
         b = 0 if e == 0 else n_pins - 1

@@ -56,8 +56,9 @@ class ClosedGeometry:
 
 
 def _wheel_centres(v):
+    from . import fixed_math as fm    # numba: loaded when first needed
     phi = equilibrium_arm_angle(v)
-    return pivots(v) + v["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
+    return pivots(v) + v["arm_length"] * np.array([fm.cos(phi), fm.sin(phi)])
 
 
 def _ends(v, spr):
@@ -66,18 +67,20 @@ def _ends(v, spr):
 
 
 def _guide(idl, outward):
+    from . import fixed_math as fm    # numba: loaded when first needed
     a = math.radians(idl["guide_angle"])
-    return np.array([outward * math.cos(a), math.sin(a)])
+    return np.array([outward * fm.cos(a), fm.sin(a)])
 
 
 def _circles(v, tr, idl, rol, sprocket, rp, idler_at):
     """The circles the pins wrap: the sprocket's pitch circle; round a wheel of radius r,
     the circle on which a link of length L0 touches the pad surface (r + h_w) at its
     middle, sqrt((r + h_w)^2 + (L0 / 2)^2)."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     hw = tr["pad_wheel"]
 
     def wrap(r):
-        return math.hypot(r + hw, 0.5 * tr["link_length"])
+        return fm.hypot(r + hw, 0.5 * tr["link_length"])
 
     c = [(x, y, wrap(v["wheel_radius"])) for x, y in _wheel_centres(v)]
     c.append((sprocket[0], sprocket[1], rp))
@@ -115,8 +118,9 @@ def _slide_for(length_at, target, travel):
 def _span_angles(hull, idler_at, reach, guide):
     """Angles to the guide of the two spans that leave the idler: the loop's edges from
     the ends of its arc on the idler, each way round."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     pts = hull[:-1]
-    on = np.abs(np.hypot(*(pts - idler_at).T) - reach) < 1e-9 + 1e-7 * reach
+    on = np.abs(fm.vhypot(*(pts - idler_at).T) - reach) < 1e-9 + 1e-7 * reach
     idx = np.flatnonzero(on)
     n = len(pts)
     if idx.size == 0 or idx.size == n:
@@ -127,17 +131,18 @@ def _span_angles(hull, idler_at, reach, guide):
         while on[(b + step) % n]:
             b = (b + step) % n
         d = pts[(b + step) % n] - pts[b]
-        angles.append(math.acos(np.clip(-(d @ guide) / np.hypot(*d), -1.0, 1.0)))
+        angles.append(fm.acos(np.clip(-(d[0] * guide[0] + d[1] * guide[1]) / fm.vhypot(*d), -1.0, 1.0)))
     return tuple(angles)
 
 
 def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
     """Everything the closed layout derives (ClosedGeometry), or ClosedLayoutError."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     n_teeth = int(spr["teeth"])
     k = tr["link_stiffness"]
     pitch = tr["link_length"] + tr["tension"] / k
     rp = spr["pitch_radius"] or _pitch_radius(pitch, n_teeth)
-    tooth_pitch = 2.0 * rp * math.sin(math.pi / n_teeth)
+    tooth_pitch = 2.0 * rp * fm.sin(math.pi / n_teeth)
     if abs(tooth_pitch / pitch - 1.0) > TOOTH_PITCH_TOLERANCE:
         raise ClosedLayoutError(
             f"sprocket.teeth = {n_teeth} with pitch_radius {rp:.4g} m spaces the seats {tooth_pitch:.4g} m apart, but "
@@ -147,12 +152,12 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
     if not rpin < rg:
         raise ClosedLayoutError(f"sprocket.pin_radius = {rpin} m must be smaller than sprocket.seat_radius = {rg} m")
     rs = rp + rg - rpin
-    if 2.0 * rg >= 2.0 * rs * math.sin(math.pi / n_teeth):
+    if 2.0 * rg >= 2.0 * rs * fm.sin(math.pi / n_teeth):
         raise ClosedLayoutError(f"sprocket.seat_radius = {rg} m leaves no teeth between {n_teeth} seats; allowed: "
-                                f"below {rs * math.sin(math.pi / n_teeth):.4g} m")
+                                f"below {rs * fm.sin(math.pi / n_teeth):.4g} m")
     tip = spr["tip_radius"] or rp + rpin
-    if not math.hypot(rs, rg) < tip < rp + 3.0 * rpin:
-        raise ClosedLayoutError(f"sprocket.tip_radius = {tip:.4g} m must lie between {math.hypot(rs, rg):.4g} m (the "
+    if not fm.hypot(rs, rg) < tip < rp + 3.0 * rpin:
+        raise ClosedLayoutError(f"sprocket.tip_radius = {tip:.4g} m must lie between {fm.hypot(rs, rg):.4g} m (the "
                                 f"seats' rims) and {rp + 3.0 * rpin:.4g} m (pitch radius + 3 pin radii)")
     sprocket, idler = _ends(v, spr)
     guide = _guide(idl, 1.0 if idler[0] > sprocket[0] else -1.0)
@@ -173,9 +178,9 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
             f"or a longer idler.travel")
     circles = _circles(v, tr, idl, rol, sprocket, rp, idler + slide * guide)
     hull, _ = closed_loop(circles, SEARCH_SAMPLES)
-    reach_i = math.hypot(idl["radius"] + tr["pad_wheel"], 0.5 * tr["link_length"])
+    reach_i = fm.hypot(idl["radius"] + tr["pad_wheel"], 0.5 * tr["link_length"])
     a1, a2 = _span_angles(hull, idler + slide * guide, reach_i, guide)
-    preload = idl["preload"] or tr["tension"] * (math.cos(a1) + math.cos(a2)) + idl["stiffness"] * slide
+    preload = idl["preload"] or tr["tension"] * (fm.cos(a1) + fm.cos(a2)) + idl["stiffness"] * slide
     _check_rollers(tr, rol, circles)
     return ClosedGeometry(n, pitch, rp, tip, preload, slide, sprocket, idler, guide, (a1, a2), n_teeth, rpin,
                           circles)
@@ -184,31 +189,33 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
 def loop_pins(g):
     """n_links pins on the taut loop (body frame), clockwise (front to rear along the
     ground, as the paper's track), and the sprocket angle that seats one of them."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     pins, _ = closed_track(g.circles, g.n_links)
     pins = pins[::-1].copy()
     d = pins - g.sprocket
-    r = np.hypot(*d.T)
+    r = fm.vhypot(*d.T)
     b = int(np.argmin(np.abs(r - g.pitch_radius) + 1e-3 * np.abs(pins[:, 0] - g.sprocket[0])))
-    angle = math.atan2(d[b, 1], d[b, 0])
+    angle = fm.atan2(d[b, 1], d[b, 0])
     # every pin near the teeth into its seat: the taut loop leaves the pitch circle along
     # its tangents, which would put the next pins on the teeth's flanks
     pitch = 2.0 * math.pi / g.teeth
     near = r < g.tip_radius + g.pin_radius
-    k = np.round((np.arctan2(d[near, 1], d[near, 0]) - angle) / pitch)
+    k = np.round((fm.vatan2(d[near, 1], d[near, 0]) - angle) / pitch)
     seat = angle + k * pitch
-    pins[near] = g.sprocket + g.pitch_radius * np.column_stack([np.cos(seat), np.sin(seat)])
+    pins[near] = g.sprocket + g.pitch_radius * np.column_stack([fm.vcos(seat), fm.vsin(seat)])
     return pins, angle
 
 
 def _check_rollers(tr, rol, circles):
     """Each support roller must touch the loop that sprocket, road wheels and idler span."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     n_rollers = len(rol["positions"])
     hull, _ = closed_loop(circles[:len(circles) - n_rollers], SEARCH_SAMPLES)
     a, d = hull[:-1], np.diff(hull, axis=0)
     for j, (x, y) in enumerate(rol["positions"]):
         p = np.array([x, y])
         t = np.clip(((p - a) * d).sum(1) / (d * d).sum(1), 0.0, 1.0)
-        gap = np.hypot(*(a + t[:, None] * d - p).T).min() - (rol["radius"] + tr["pad_wheel"])
+        gap = fm.vhypot(*(a + t[:, None] * d - p).T).min() - (rol["radius"] + tr["pad_wheel"])
         if abs(gap) > tr["link_length"]:
             raise ClosedLayoutError(f"rollers.positions[{j}] = [{x}, {y}] puts the roller {gap:+.3g} m from the track "
                                     "(+ outside, - inside the loop): a support roller must touch the return run "

@@ -7,13 +7,14 @@ from numba import njit
 
 from .contact_laws import DAMPING_NONE, DAMPING_VISCOUS, LAW_POWER
 from .jit import SCALAR
+from . import fixed_math as fm
 
 
 @njit(**SCALAR)
 def elastic(law, k, n, delta):
     """(force, stored energy) of the pad spring at compression delta > 0."""
     if law == LAW_POWER:
-        f = k * delta ** n
+        f = k * fm.pow(delta, n)
         return f, f * delta / (n + 1.0)
     return k * delta, 0.5 * k * delta ** 2
 

@@ -59,5 +59,6 @@ def restitution_factor(damping, e):
 
 def damping_ratio_for_restitution(e):
     """zeta of a linear spring-dashpot that rebounds with restitution e (beyond_paper.md)."""
-    le = math.log(e)
-    return -le / math.sqrt(math.pi ** 2 + le * le)
+    from . import fixed_math as fm    # numba: loaded when first needed
+    le = fm.log(e)
+    return -le / math.sqrt(math.pi * math.pi + le * le)

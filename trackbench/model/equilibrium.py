@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from ..solvers import dense
 from ..status import EquilibriumError
 from . import layout as L
 from .index import n_coordinates, n_state, pin_offset, q_idler, q_sprocket
@@ -22,6 +23,7 @@ from .loop import loop_rhs
 from .rhs import rhs
 from .terrain import flat_ground
 from .track_path import initial_track
+from . import fixed_math as fm
 
 
 
@@ -155,8 +157,7 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     for k in range(2, u.shape[0]):
         q[L.Q_ARM + nw + k - 2] = u[k]
     _loads_at_rest(q, m, w, diag)
-    c = math.cos(u[1])
-    s = math.sin(u[1])
+    s, c = fm.sincos(u[1])
     g = par[L.P_GRAVITY]
     ma = par[L.P_ARM_MASS]
     yc = u[0]
@@ -190,10 +191,9 @@ def _newton(P, u, target, max_iter):
     while norm > target and it < max_iter:
         it += 1
         J = P.jacobian(u)
-        try:
-            du = np.linalg.solve(J, -r)
-        except np.linalg.LinAlgError:   # e.g. the closed loop before its pins press on the teeth
-            du = np.linalg.lstsq(J, -r, rcond=None)[0]
+        du = np.empty(u.size)
+        if not dense.solve(J, -r, du):   # e.g. the closed loop before its pins press on the teeth
+            dense.least_squares(J, -r, du)
         lam = 1.0
         while True:
             un = u + lam * du
@@ -218,13 +218,16 @@ def _levenberg_marquardt(P, u, target, max_iter):
     while np.abs(r).max() > target and it < max_iter:
         it += 1
         J = P.jacobian(u)
-        A = J.T @ J
-        g = J.T @ r
+        A = np.empty((u.size, u.size))
+        g = np.empty(u.size)
+        dense.normal_equations(J, r, A, g)
         d = np.diag(A).copy() + 1e-30
+        du = np.empty(u.size)
         for _ in range(30):
-            du = np.linalg.solve(A + lam * np.diag(d), -g)
+            if not dense.solve(A + lam * np.diag(d), -g, du):
+                du[:] = 0.0
             rn, _, _ = P.residual(u + du)
-            if rn @ rn < r @ r:
+            if dense.dot(rn, rn) < dense.dot(r, r):
                 u, r = u + du, rn
                 lam = max(lam / 5.0, 1e-9)
                 break
@@ -267,7 +270,7 @@ def _chain(P, u, target, max_iter, exponent, stiffnesses, d, solve, step=0.05):
     for m in np.linspace(1.0, n, 1 + int(math.ceil(abs(n - 1.0) / step))):
         par[exponent] = m
         for i, ki in zip(stiffnesses, k):
-            par[i] = ki * d ** (n - m)
+            par[i] = ki * fm.pow(d, n - m)
         u, norm, j = solve(P, u, target if m == n else 1e-6 * P.weight, max_iter)
         it += j
     par[exponent] = n
@@ -282,14 +285,14 @@ def _continuation(P, u, target, max_iter):
     n = P.par[L.P_CONTACT_EXPONENT]
     if n == 1.0:
         return _newton(P, u, target, max_iter)
-    d = (P.weight / (P.nw * P.par[L.P_K_WHEEL])) ** (1.0 / n)
+    d = fm.pow(P.weight / (P.nw * P.par[L.P_K_WHEEL]), 1.0 / n)
     return _chain(P, u, target, max_iter, L.P_CONTACT_EXPONENT, (L.P_K_WHEEL, L.P_K_GROUND), d, _newton)
 
 
 def _uniform_sinkage(P, pins_on_soil):
     """Bekker's sinkage under the weight spread evenly over that many pins' areas."""
     p = P.weight / (pins_on_soil * P.par[L.P_PIN_AREA])
-    return (p / P.par[L.P_SOIL_K]) ** (1.0 / P.par[L.P_SOIL_N])
+    return fm.pow(p / P.par[L.P_SOIL_K], 1.0 / P.par[L.P_SOIL_N])
 
 
 def _newton_rounded(P, u, target, max_iter):
@@ -344,7 +347,7 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
     hg = P.par[L.P_PAD_GROUND]
     # start: wheels resting on the track, the track on the ground, chassis level
-    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([np.cos(P.phi), np.sin(P.phi)])
+    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array([fm.vcos(P.phi), fm.vsin(P.phi)])
     yc = -wcb[:, 1].min() + rho + hg
     ends_w = P.ends + [0.0, yc]
     pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)

@@ -11,6 +11,7 @@ from .bundles import ARM_COLS, ARM_COS, ARM_SIN
 from .jit import INLINE, KERNEL
 from .index import q_pin
 from .layout import ARMS_PX, ARMS_PY, P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y
+from . import fixed_math as fm
 
 
 @njit(**INLINE)
@@ -40,13 +41,11 @@ def _free_pins(coords, nw, last, out):
 def place_wheels(q, par, arms, wc, arm):
     """Road-wheel centres of configuration q into wc; cos and sin of each arm's absolute
     angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
-    c = math.cos(q[Q_PITCH])
-    s = math.sin(q[Q_PITCH])
+    s, c = fm.sincos(q[Q_PITCH])
     la = par[P_ARM_LENGTH]
     for i in range(arms.shape[0]):
         beta = q[Q_PITCH] + q[Q_ARM + i]
-        cb = math.cos(beta)
-        sb = math.sin(beta)
+        sb, cb = fm.sincos(beta)
         arm[i, ARM_COS] = cb
         arm[i, ARM_SIN] = sb
         rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)

@@ -134,7 +134,8 @@ def equilibrium_arm_angle(vehicle):
 
 
 def wheel_centres_body(vehicle):
-    """Wheel centres in the chassis frame at the initial equilibrium."""
+    """Wheel centres in the chassis frame at the initial equilibrium, for the scenario's
+    checks (the C library's sines: they decide no result, and need no compiler)."""
     phi = equilibrium_arm_angle(vehicle)
     return pivots(vehicle) + vehicle["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
 

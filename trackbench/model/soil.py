@@ -173,35 +173,39 @@ def sinkage_modulus(soil, b):
 
 def bekker_pressure(z, soil, b):
     """p = (k_c / b + k_phi) z^n on first loading; no pressure above the surface."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     z = np.asarray(z, dtype=float)
-    return _out(sinkage_modulus(soil, b) * np.maximum(z, 0.0) ** soil["n"])
+    return _out(sinkage_modulus(soil, b) * fm.vpow(np.maximum(z, 0.0), soil["n"]))
 
 
 def static_sinkage(p, soil, b):
     """z = (p / (k_c / b + k_phi))^(1/n): the sinkage under a uniform pressure p (the
     inverse of bekker_pressure); a pressure <= 0 does not sink the track."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     p = np.asarray(p, dtype=float)
-    return _out((np.maximum(p, 0.0) / sinkage_modulus(soil, b)) ** (1.0 / soil["n"]))
+    return _out(fm.vpow(np.maximum(p, 0.0) / sinkage_modulus(soil, b), 1.0 / soil["n"]))
 
 
 def janosi_shear(p, j, soil):
     """tau = (c + p tan phi)(1 - exp(-j / K)), Janosi-Hanamoto. The stress follows the
     sign of the shear displacement j (odd in j: slipping back reverses it); a tensile p
     adds no friction, so p is taken >= 0."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     p = np.maximum(np.asarray(p, dtype=float), 0.0)
     j = np.asarray(j, dtype=float)
-    strength = soil["cohesion"] + p * math.tan(math.radians(soil["friction_angle"]))
-    return _out(np.sign(j) * strength * -np.expm1(-np.abs(j) / soil["shear_modulus"]))
+    strength = soil["cohesion"] + p * fm.tan(math.radians(soil["friction_angle"]))
+    return _out(np.sign(j) * strength * -fm.vexpm1(-np.abs(j) / soil["shear_modulus"]))
 
 
 def wong_thrust(area, weight, length, slip, soil):
     """F = (A c + W tan phi)[1 - K/(i l)(1 - exp(-i l / K))]: Wong's tractive effort of a
     track of contact length l and area A under a uniform pressure, carrying W, at slip i
     in [0, 1] (i = 0 gives the limit 0)."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     slip = np.asarray(slip, dtype=float)
     if np.any((slip < 0.0) | (slip > 1.0)):
         raise ValueError(f"slip = {slip.tolist()!r} is not allowed: expected 0 <= slip <= 1")
-    strength = area * soil["cohesion"] + weight * math.tan(math.radians(soil["friction_angle"]))
+    strength = area * soil["cohesion"] + weight * fm.tan(math.radians(soil["friction_angle"]))
     x = slip * np.asarray(length, dtype=float) / soil["shear_modulus"]   # j at the rear, over K
     return _out(strength * _mobilised(x))
 
@@ -209,9 +213,10 @@ def wong_thrust(area, weight, length, slip, soil):
 def _mobilised(x):
     """1 - (1 - exp(-x)) / x, the share of the shear strength a uniformly loaded track
     mobilises; its series below x = 1e-3, where the closed form cancels."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     x = np.asarray(x, dtype=float)
     small = x < 1e-3
     xs = np.where(small, 1.0, x)            # keep the closed form away from x = 0
-    closed = (xs + np.expm1(-xs)) / xs
+    closed = (xs + fm.vexpm1(-xs)) / xs
     series = x * (0.5 - x * (1.0 / 6.0 - x * (1.0 / 24.0 - x / 120.0)))
     return np.where(small, series, closed)

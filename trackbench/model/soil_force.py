@@ -21,6 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
+from . import fixed_math as fm
 from .jit import BORROW, INLINE, KERNEL, SCALAR
 from .layout import (P_LINK_LENGTH, P_RUT_DX, P_RUT_X0, P_SOIL, P_SOIL_COHESION, P_SOIL_K, P_SOIL_KE, P_SOIL_N,
                      P_SOIL_SHEAR_K, P_SOIL_TAN_PHI)
@@ -34,8 +35,8 @@ def first_loading(z, n, k):
     """Bekker's p = k z^n; for n < 1 its slope is infinite at the surface, which no
     equilibrium search or step-size control can follow: straight to zero from SURFACE_DEPTH."""
     if n < 1.0 and z < SURFACE_DEPTH:
-        return k * SURFACE_DEPTH ** n * (z / SURFACE_DEPTH)
-    return k * z ** n
+        return k * fm.pow(SURFACE_DEPTH, n) * (z / SURFACE_DEPTH)
+    return k * fm.pow(z, n)
 
 
 @njit(**SCALAR)
@@ -156,7 +157,7 @@ def soil_shear(x, y, x0, y0, t, normal, par):
         return 0.0
     j = (x - x0) * t[0] + (y - y0) * t[1]
     limit = par[P_SOIL_COHESION] + normal * par[P_SOIL_TAN_PHI]
-    f = limit * (1.0 - math.exp(-abs(j) / par[P_SOIL_SHEAR_K]))
+    f = limit * (1.0 - fm.exp(-abs(j) / par[P_SOIL_SHEAR_K]))
     return -f if j > 0.0 else f
 
 

@@ -19,6 +19,7 @@ from numba import njit
 from . import teeth as _teeth
 from .jit import INLINE
 from .layout import LP_FLANK_ANGLE, LP_PIN_RADIUS, LP_PITCH_RADIUS, LP_SEAT_RADIUS, LP_TEETH, LP_TIP_RADIUS
+from . import fixed_math as fm
 
 
 seat_centre_radius = njit(**INLINE)(_teeth.seat_centre_radius)
@@ -47,11 +48,11 @@ def tooth_shape(lp):
     alpha = lp[LP_FLANK_ANGLE]
     rs = seat_centre_radius(lp[LP_PITCH_RADIUS], rg, rpin)
     pitch = 2.0 * math.pi / lp[LP_TEETH]
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    t_end = flank_length(rs, rg, rt, alpha)        # the flank from (0, rg) along (cos, sin) alpha
-    corner = math.atan2(rg + t_end * sa, rs + t_end * ca)
-    return (rg, rt, rpin, rs, pitch, ca, sa, math.tan(alpha), t_end, math.cos(corner), math.sin(corner),
-            math.cos(0.5 * pitch), math.sin(0.5 * pitch))
+    sa, ca = fm.sincos(alpha)
+    t_end = flank_length(rs, rg, rt, ca, sa)        # the flank from (0, rg) along (cos, sin) alpha
+    s_corner, c_corner = fm.sincos(fm.atan2(rg + t_end * sa, rs + t_end * ca))
+    s_half, c_half = fm.sincos(0.5 * pitch)
+    return rg, rt, rpin, rs, pitch, ca, sa, fm.tan(alpha), t_end, c_corner, s_corner, c_half, s_half
 
 
 @njit(**INLINE)
@@ -105,10 +106,9 @@ def pin_on_teeth(dx, dy, angle, shape):
     r2 = dx * dx + dy * dy
     if r2 >= (rt + rpin) * (rt + rpin):   # most pins: far from the teeth
         return -1.0, 0.0, 0.0, False
-    k = math.floor((math.atan2(dy, dx) - angle) / pitch + 0.5)   # the nearest gap
+    k = math.floor((fm.atan2(dy, dx) - angle) / pitch + 0.5)   # the nearest gap
     ga = angle + k * pitch
-    ux = math.cos(ga)
-    uy = math.sin(ga)
+    uy, ux = fm.sincos(ga)
     a = dx * ux + dy * uy - rs
     b = -dx * uy + dy * ux
     side = 1.0 if b >= 0.0 else -1.0

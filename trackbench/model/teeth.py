@@ -7,7 +7,8 @@ import math
 
 def pitch_radius(link_pitch, teeth):
     """r_p = p / (2 sin(pi / N)): the seats of an N-tooth sprocket one pitch apart."""
-    return link_pitch / (2.0 * math.sin(math.pi / teeth))
+    from .fixed_math import sin    # numba: loaded when first needed
+    return link_pitch / (2.0 * sin(math.pi / teeth))
 
 
 def seat_centre_radius(pitch_radius, seat_radius, pin_radius):
@@ -15,20 +16,21 @@ def seat_centre_radius(pitch_radius, seat_radius, pin_radius):
     return pitch_radius + seat_radius - pin_radius
 
 
-def flank_length(rs, rg, rt, alpha):
-    """Length of a flank from the seat's half circle to the tip circle."""
-    b = rs * math.cos(alpha) + rg * math.sin(alpha)
+def flank_length(rs, rg, rt, cos_alpha, sin_alpha):
+    """Length of a flank at angle alpha from the seat's half circle to the tip circle."""
+    b = rs * cos_alpha + rg * sin_alpha
     return -b + math.sqrt(max(b * b - (rs * rs + rg * rg - rt * rt), 0.0))
 
 
 def profile(teeth, pitch_radius, seat_radius, tip_radius, pin_radius, angle=0.0, per_arc=12,
             flank_angle=math.radians(15.0)):
-    """The tooth profile as a closed polyline (n, 2) about the axis, for drawing; angles in rad."""
+    """The tooth profile as a closed polyline (n, 2) about the axis, for drawing (the C
+    library's sines do); angles in rad."""
     import numpy as np
     rg, rt, al = seat_radius, tip_radius, flank_angle
     rs = pitch_radius + seat_radius - pin_radius
     pitch = 2.0 * math.pi / teeth
-    t_end = flank_length(rs, rg, rt, al)
+    t_end = flank_length(rs, rg, rt, math.cos(al), math.sin(al))
     corner = math.atan2(rg + t_end * math.sin(al), rs + t_end * math.cos(al))
     local = []          # one gap and the tooth top after it, in the gap's frame (x along the gap)
     for t in np.linspace(t_end, 0.0, max(2, per_arc // 3)):          # flank on the -b side, inwards

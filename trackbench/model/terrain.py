@@ -31,6 +31,7 @@ def _straight_through(verts):
 def ground_from_points(points, merge_straight=False):
     """Build a Ground from interior points; extends the ends horizontally to +-FAR;
     merge_straight: one segment where consecutive ones run on in the same direction."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     pts = np.asarray(points, dtype=float).reshape(-1, 2)
     left = [-FAR, pts[0, 1]] if pts[0, 0] > -FAR else None
     right = [FAR, pts[-1, 1]] if pts[-1, 0] < FAR else None
@@ -42,7 +43,7 @@ def ground_from_points(points, merge_straight=False):
     if merge_straight:
         verts = _straight_through(verts)
     d = np.diff(verts, axis=0)
-    length = np.hypot(d[:, 0], d[:, 1])
+    length = fm.vhypot(d[:, 0], d[:, 1])
     t = d / length[:, None]
     n = np.column_stack([-t[:, 1], t[:, 0]])
     seg = np.column_stack([verts[:-1], t, length, n])
@@ -73,10 +74,11 @@ def contact_x(eq, height, pad_ground):
     """x* of the spec: the largest x at which the resting track's ground-side surface
     (links offset by h_g along the outer normal, circles of radius h_g at pins bent
     convex towards the ground) is at the given height."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     a = eq.info["pins"]
     best = -np.inf
     t = np.diff(a, axis=0)
-    t /= np.hypot(t[:, 0], t[:, 1])[:, None]
+    t /= fm.vhypot(t[:, 0], t[:, 1])[:, None]
     n_out = np.column_stack([-t[:, 1], t[:, 0]])  # -n_inner
     for b in range(len(t)):
         p0 = a[b] + pad_ground * n_out[b]
@@ -89,7 +91,7 @@ def contact_x(eq, height, pad_ground):
         if t[b - 1, 0] * t[b, 1] - t[b - 1, 1] * t[b, 0] < 0.0:  # convex towards the ground
             dy = height - a[b, 1]
             if abs(dy) <= pad_ground:
-                best = max(best, a[b, 0] + np.sqrt(pad_ground ** 2 - dy ** 2))
+                best = max(best, a[b, 0] + np.sqrt(pad_ground * pad_ground - dy * dy))
     if not np.isfinite(best):
         raise ValueError(f"the resting track never reaches height {height} m: the obstacle cannot be placed by "
                          "first_contact_time; give terrain.position instead")

@@ -28,11 +28,12 @@ def _lower_hull(points):
 def initial_track(ends_world, wheel_centres, rho, n_links):
     """Pins spread evenly along the taut path: the lower convex hull of the track ends
     and the wheel circles of radius rho (wheel radius + pad). Pin 0 is the front end."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     ang = np.linspace(0.0, 2 * np.pi, 361)[:-1]
-    circ = [c + rho * np.column_stack([np.cos(ang), np.sin(ang)]) for c in wheel_centres]
+    circ = [c + rho * np.column_stack([fm.vcos(ang), fm.vsin(ang)]) for c in wheel_centres]
     hull = _lower_hull(np.vstack([ends_world] + circ))
     hull = hull[::-1]  # front (largest x) to rear
-    seg = np.hypot(*np.diff(hull, axis=0).T)
+    seg = fm.vhypot(*np.diff(hull, axis=0).T)
     s = np.concatenate([[0.0], np.cumsum(seg)])
     target = np.linspace(0.0, s[-1], n_links + 1)
     pins = np.column_stack([np.interp(target, s, hull[:, 0]), np.interp(target, s, hull[:, 1])])
@@ -50,17 +51,19 @@ def closed_loop(circles, samples=2048):
     closed polygon (counter-clockwise, first point repeated at the end) with each circle
     sampled at `samples` points (the hull's length then errs by about r (pi / samples)^2 / 6
     per unit of wrapped arc), and its length."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     ang = np.linspace(0.0, 2 * np.pi, samples, endpoint=False)
-    ring = np.column_stack([np.cos(ang), np.sin(ang)])
+    ring = np.column_stack([fm.vcos(ang), fm.vsin(ang)])
     pts = np.vstack([np.array(c[:2]) + c[2] * ring for c in circles])
     hull = _hull(pts)
     hull = np.vstack([hull, hull[:1]])
-    return hull, float(np.hypot(*np.diff(hull, axis=0).T).sum())
+    return hull, float(fm.vhypot(*np.diff(hull, axis=0).T).sum())
 
 
 def _dense(hull, ds):
     """The closed polygon resampled every ~ds of arc length: (points, arc lengths)."""
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(hull, axis=0).T))])
+    from . import fixed_math as fm    # numba: loaded when first needed
+    s = np.concatenate([[0.0], np.cumsum(fm.vhypot(*np.diff(hull, axis=0).T))])
     t = np.linspace(0.0, s[-1], int(np.ceil(s[-1] / ds)) + 1)
     return np.column_stack([np.interp(t, s, hull[:, 0]), np.interp(t, s, hull[:, 1])]), t
 
@@ -68,16 +71,17 @@ def _dense(hull, ds):
 def _walk(dense, arc, chord, n):
     """n pins from dense[0] on, each the first point of the loop at distance `chord` beyond
     the last: (pins, arc length at which the n-th step lands, beyond one turn if it does)."""
+    from . import fixed_math as fm    # numba: loaded when first needed
     pins = [dense[0]]
     k = 0
     window = 2 + int(np.ceil(4.0 * chord / (arc[1] - arc[0])))   # a chord spans less arc than this
     for _ in range(n):
-        d = np.hypot(*(dense[k + 1:k + 1 + window] - pins[-1]).T)
+        d = fm.vhypot(*(dense[k + 1:k + 1 + window] - pins[-1]).T)
         hit = np.flatnonzero(d >= chord)
         if hit.size == 0:
             return np.array(pins), arc[-1] + chord
         j = k + 1 + hit[0]
-        d0 = np.hypot(*(dense[j - 1] - pins[-1]))
+        d0 = fm.vhypot(*(dense[j - 1] - pins[-1]))
         f = (chord - d0) / (d[hit[0]] - d0)
         pins.append(dense[j - 1] + f * (dense[j] - dense[j - 1]))
         k = j - 1

@@ -9,6 +9,7 @@ from ..model.jit import BORROW, INLINE, KERNEL
 
 from ..model.layout import S_H_MAX, S_H_MIN, S_N_OUT, S_REJECTED, S_RHS, S_STATUS, S_STEPS, S_T_FINAL
 from ..status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
+from ..model import fixed_math as fm
 
 SAFETY = 0.9
 FAC_MIN = 0.2
@@ -49,7 +50,7 @@ def after_rejection(h, err, expo, th, h_min):
     if err == err and err > 0.0:
         if th < 1.0 and th * h > h_min:
             return h * th, True
-        return h * max(FAC_MIN, SAFETY * err ** expo), False
+        return h * max(FAC_MIN, SAFETY * fm.pow(err, expo)), False
     return h * FAC_MIN, False
 
 
@@ -59,7 +60,7 @@ def after_acceptance(h, err, expo, fac_max, h_max):
     if err == 0.0:
         fac = fac_max
     else:
-        fac = min(fac_max, SAFETY * err ** expo)
+        fac = min(fac_max, SAFETY * fm.pow(err, expo))
     return min(h * fac, h_max)
 
 

@@ -33,6 +33,7 @@ from ..model.layout import (
     LP_SPROCKET_X, LP_SPROCKET_Y, LP_TOOTH_DAMPING, N_KINDS, NB_COUNT, P_ARM_LENGTH, P_CONTACT_DAMPING, P_CONTACT_GEOMETRY, P_DAMPING_RAMP, SEG_LENGTH, P_PAD_GROUND, P_PAD_WHEEL, P_SOIL, P_WHEEL_RADIUS, Q_ARM, Q_PITCH, Q_X, Q_Y,
 )
 from .hermite import coordinate, quintic_basis
+from ..model import fixed_math as fm
 
 BISECTIONS = 24
 
@@ -47,7 +48,7 @@ def _paper_pin_at(b, w, step, nq, m, n_links):
     if b == 0 or b == n_links:
         e = 0 if b == 0 else 1
         th = coordinate(w, step, Q_PITCH, nq)
-        rx, ry = body_offset(math.cos(th), math.sin(th), m.ends[e, 0], m.ends[e, 1])
+        rx, ry = body_offset(fm.cos(th), fm.sin(th), m.ends[e, 0], m.ends[e, 1])
         return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
     k = q_pin(m.arms.shape[0], b)
     return coordinate(w, step, k, nq), coordinate(w, step, k + 1, nq)
@@ -108,7 +109,7 @@ def _guide_at_impl(j, w, step, nq, m, ev):
         def closed(j, w, step, nq, m, ev):
             th = coordinate(w, step, Q_PITCH, nq)
             sl = coordinate(w, step, q_idler(m.arms.shape[0], ev.pins0.shape[0] - 1), nq)
-            rx, ry, _, _ = guide_offset(j, sl, m, math.cos(th), math.sin(th))
+            rx, ry, _, _ = guide_offset(j, sl, m, fm.cos(th), fm.sin(th))
             return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
         return closed
     return lambda j, w, step, nq, m, ev: (0.0, 0.0)
@@ -135,7 +136,7 @@ def _teeth_gap(px, py, q, lp, shape):
     model/sprocket.py; shape its tooth_shape), q = (x, y, pitch, sprocket angle psi) of
     chassis and sprocket; the axis placed as loop.py places it."""
     x, y, th, psi = q
-    ax, ay = body_offset(math.cos(th), math.sin(th), lp[LP_SPROCKET_X], lp[LP_SPROCKET_Y])
+    ax, ay = body_offset(fm.cos(th), fm.sin(th), lp[LP_SPROCKET_X], lp[LP_SPROCKET_Y])
     return pin_on_teeth(px - (x + ax), py - (y + ay), th + psi, shape)[0]
 
 
@@ -161,8 +162,8 @@ def _teeth_gap_at_impl(b, t, step, nq, m, n_links, ev):
 def _wheel_at(i, w, step, nq, m):
     th = coordinate(w, step, Q_PITCH, nq)
     beta = th + coordinate(w, step, Q_ARM + i, nq)
-    rx, ry = wheel_offset(math.cos(th), math.sin(th), m.arms, i, m.par[P_ARM_LENGTH], math.cos(beta),
-                          math.sin(beta))
+    rx, ry = wheel_offset(fm.cos(th), fm.sin(th), m.arms, i, m.par[P_ARM_LENGTH], fm.cos(beta),
+                          fm.sin(beta))
     return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
 
 
