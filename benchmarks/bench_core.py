@@ -20,8 +20,8 @@ import numpy as np
 from numba import njit
 
 import trackbench as tb
-from trackbench.model import layout as L
-from trackbench.model.reduced import reduced_rhs
+from trackbench.model.core import indices as L
+from trackbench.model.dynamics.reduced import reduced_rhs
 from trackbench.simulate import Model, build_ground, equilibrium, initial_state
 
 REPEATS = 3
@@ -50,12 +50,12 @@ def rhs_microseconds(ds, sc):
     i = int(np.searchsorted(ds.time.values, 0.3))
     y = np.zeros(2 * nq + 1)
     y[[L.Q_X, L.Q_Y, L.Q_PITCH]] = [float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")]
-    y[L.Q_ARM:L.Q_ARM + m.nw] = ds.arm_angle.values[i]
+    y[L.Q_ARM : L.Q_ARM + m.nw] = ds.arm_angle.values[i]
     off = L.pin_offset(m.nw)
     y[off:nq:2] = ds.pin_x.values[i, 1:-1]
-    y[off + 1:nq:2] = ds.pin_y.values[i, 1:-1]
+    y[off + 1 : nq : 2] = ds.pin_y.values[i, 1:-1]
     y[nq] = 10.0
-    y[nq + off:2 * nq:2] = 10.0
+    y[nq + off : 2 * nq : 2] = 10.0
     dy = np.zeros_like(y)
     d = np.zeros(L.n_diag(m.nw, m.n_links))
     args = (m.arrays, m.work, dy, d)
@@ -72,6 +72,7 @@ def rhs_microseconds(ds, sc):
 def scipy_baseline(sc, method):
     """solve_ivp driving the same compiled right-hand side; returns (wall, steps, nfev)."""
     from scipy.integrate import solve_ivp
+
     eq = equilibrium(sc)
     ground, _ = build_ground(sc, eq)
     m = Model(sc, eq, ground)
@@ -86,8 +87,17 @@ def scipy_baseline(sc, method):
 
     tol = sc["tolerance"]
     t = time.perf_counter()
-    r = solve_ivp(f, (0.0, sc["duration"]), y0, method=method, rtol=tol, atol=tol,
-                  max_step=sc["output_interval"], first_step=1e-5, dense_output=False)
+    r = solve_ivp(
+        f,
+        (0.0, sc["duration"]),
+        y0,
+        method=method,
+        rtol=tol,
+        atol=tol,
+        max_step=sc["output_interval"],
+        first_step=1e-5,
+        dense_output=False,
+    )
     return time.perf_counter() - t, r.t.size - 1, r.nfev, r.status
 
 
@@ -113,21 +123,28 @@ def main(quick=False):
     ds = best_run(sc)
     a = ds.attrs
     wall = a["solve_time"]
-    print(f"wall {wall:.3f} s (best of {REPEATS})  simulated/wall {sc['duration'] / wall:.2f}  steps {a['steps']} "
-          f"(+{a['rejected_steps']} rejected)  rhs {a['rhs_evaluations']}  "
-          f"wall per rhs (loop included) {wall / a['rhs_evaluations'] * 1e6:.3f} us")
+    print(
+        f"wall {wall:.3f} s (best of {REPEATS})  simulated/wall {sc['duration'] / wall:.2f}  steps "
+        f"{a['steps']} (+{a['rejected_steps']} rejected)  rhs {a['rhs_evaluations']}  "
+        f"wall per rhs (loop included) {wall / a['rhs_evaluations'] * 1e6:.3f} us"
+    )
     print(f"one right-hand side alone: {rhs_microseconds(ds, sc):.3f} us   (target < 1 us)")
-    print(f"energy residual {float(ds.max_energy_residual):.2e}  energy balance {100 * float(ds.max_energy_balance_error):.4f} %  "
-          f"peak wheel 1 {float(ds.peak_wheel_force_y[0]) / 1e3:.2f} kN")
+    print(
+        f"energy residual {float(ds.max_energy_residual):.2e}  energy balance "
+        f"{100 * float(ds.max_energy_balance_error):.4f} %  peak wheel 1 "
+        f"{float(ds.peak_wheel_force_y[0]) / 1e3:.2f} kN"
+    )
 
     print("\n== trackbench loop vs scipy solve_ivp on the same compiled rhs, same tolerance ==")
     for method, ours in (("DOP853", "dop853"), ("RK45", "dopri5")):
         sco = sc.with_overrides({"method": ours})
         dso = best_run(sco)
         w, steps, nfev, status = scipy_baseline(sco, method)
-        print(f"{method:7s} tol {sc['tolerance']:g}: trackbench {dso.attrs['solve_time']:.3f} s "
-              f"({dso.attrs['steps']} steps, {dso.attrs['rhs_evaluations']} rhs)   solve_ivp {w:.2f} s "
-              f"({steps} steps, {nfev} rhs, status {status})   ratio {w / dso.attrs['solve_time']:.1f}x")
+        print(
+            f"{method:7s} tol {sc['tolerance']:g}: trackbench {dso.attrs['solve_time']:.3f} s "
+            f"({dso.attrs['steps']} steps, {dso.attrs['rhs_evaluations']} rhs)   solve_ivp {w:.2f} s "
+            f"({steps} steps, {nfev} rhs, status {status})   ratio {w / dso.attrs['solve_time']:.1f}x"
+        )
 
     print("\n== work-precision (0.5 s; errors against the tightest run of each method) ==")
     tols = [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
@@ -138,12 +155,18 @@ def main(quick=False):
         ref = runs[-1]
         p_ref = float(ref.peak_wheel_force_y[0])
         y_ref = float(ref.chassis_y.sel(time=0.2, method="nearest"))
-        print(f"{method}: tol      wall[s]  steps  rejected  err peak wheel 1  err chassis_y(0.2)  energy residual  balance[%]")
+        print(
+            f"{method}: tol      wall[s]  steps  rejected  err peak wheel 1  err chassis_y(0.2)  "
+            "energy residual  balance[%]"
+        )
         for t, r in zip(tols, runs):
             ep = abs(float(r.peak_wheel_force_y[0]) - p_ref) / p_ref
             ey = abs(float(r.chassis_y.sel(time=0.2, method="nearest")) - y_ref)
-            print(f"        {t:7.0e}  {r.attrs['solve_time']:7.3f}  {r.attrs['steps']:5d}  {r.attrs['rejected_steps']:8d}  "
-                  f"{ep:16.2e}  {ey:15.2e} m  {float(r.max_energy_residual):15.2e}  {100 * float(r.max_energy_balance_error):9.4f}")
+            print(
+                f"        {t:7.0e}  {r.attrs['solve_time']:7.3f}  {r.attrs['steps']:5d}  "
+                f"{r.attrs['rejected_steps']:8d}  {ep:16.2e}  {ey:15.2e} m  "
+                f"{float(r.max_energy_residual):15.2e}  {100 * float(r.max_energy_balance_error):9.4f}"
+            )
 
 
 if __name__ == "__main__":

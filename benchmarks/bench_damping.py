@@ -14,8 +14,11 @@ REPEATS = 7
 
 
 def main():
-    variants = {"paper": tb.Scenario.paper(), "damped": tb.Scenario.paper(preset="damped"),
-                "continuous": tb.Scenario.paper(**{"contact.geometry": "continuous"})}
+    variants = {
+        "paper": tb.Scenario.paper(),
+        "damped": tb.Scenario.paper(preset="damped"),
+        "continuous": tb.Scenario.paper(**{"contact.geometry": "continuous"}),
+    }
     for sc in variants.values():
         tb.simulate(sc.with_overrides({"duration": 0.02}))  # compiled / loaded before timing
     best = {k: float("inf") for k in variants}
@@ -27,8 +30,11 @@ def main():
             best[name] = min(best[name], ds.attrs["solve_time"])
     for name, ds in runs.items():
         a = ds.attrs
-        print(f"{name:10s} solve {best[name]:.4f} s (best of {REPEATS})  steps {a['steps']} (+{a['rejected_steps']} "
-              f"rejected)  rhs {a['rhs_evaluations']}  residual {float(ds.max_energy_residual):.1e}")
+        print(
+            f"{name:10s} solve {best[name]:.4f} s (best of {REPEATS})  steps {a['steps']} "
+            f"(+{a['rejected_steps']} rejected)  rhs {a['rhs_evaluations']}  residual "
+            f"{float(ds.max_energy_residual):.1e}"
+        )
     print(f"damped / paper: {best['damped'] / best['paper']:.2f}  (target: at most 1.2)")
     print(f"continuous / paper: {best['continuous'] / best['paper']:.2f}")
 

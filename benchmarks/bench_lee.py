@@ -25,11 +25,14 @@ def main(argv=None):
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--duration", type=float, default=0.5)
     args = ap.parse_args(argv)
-    scen = {"reduced": tb.Scenario.paper(duration=args.duration),
-            "lee": tb.Scenario.paper(duration=args.duration, solver="lee"),
-            "lee n=1": tb.Scenario.paper(duration=args.duration, solver="lee", **{"lee.accel_order": 1}),
-            "lee A_n every step": tb.Scenario.paper(duration=args.duration, solver="lee",
-                                                    **{"lee.matrix_update_angle": 0.0})}
+    scen = {
+        "reduced": tb.Scenario.paper(duration=args.duration),
+        "lee": tb.Scenario.paper(duration=args.duration, solver="lee"),
+        "lee n=1": tb.Scenario.paper(duration=args.duration, solver="lee", **{"lee.accel_order": 1}),
+        "lee A_n every step": tb.Scenario.paper(
+            duration=args.duration, solver="lee", **{"lee.matrix_update_angle": 0.0}
+        ),
+    }
     for s in scen.values():  # warm-up: compile / load caches, solve the equilibrium
         tb.simulate(s.with_overrides({"duration": 0.01}))
     best = {}
@@ -40,17 +43,25 @@ def main(argv=None):
         ds = runs[0][1]
         best[name] = wall
         steps = ds.attrs["steps"]
-        line = (f"{name:18s} wall {wall:6.3f} s (solver {solve:6.3f} s)  status {ds.attrs['status']}  "
-                f"steps {steps}  rejected {ds.attrs['rejected_steps']}  rhs {ds.attrs.get('rhs_evaluations', '?')}")
+        line = (
+            f"{name:18s} wall {wall:6.3f} s (solver {solve:6.3f} s)  status {ds.attrs['status']}  "
+            f"steps {steps}  rejected {ds.attrs['rejected_steps']}  rhs "
+            f"{ds.attrs.get('rhs_evaluations', '?')}"
+        )
         print(line)
         if name.startswith("lee"):
-            per = {lvl: float(ds[f"lee_total_iterations_{lvl}"]) / steps
-                   for lvl in ("position", "velocity", "acceleration")}
-            print(f"         iterations per accepted step: position {per['position']:.3f}  "
-                  f"velocity {per['velocity']:.3f}  acceleration {per['acceleration']:.3f}  "
-                  f"(totals {int(ds['lee_total_iterations_position'])} / {int(ds['lee_total_iterations_velocity'])}"
-                  f" / {int(ds['lee_total_iterations_acceleration'])}); RKN passes {int(ds['lee_step_passes'])}; "
-                  f"eps1 {float(ds['lee_eps1']):.4f}; A_n builds {int(ds['lee_matrix_builds'])}")
+            per = {
+                lvl: float(ds[f"lee_total_iterations_{lvl}"]) / steps
+                for lvl in ("position", "velocity", "acceleration")
+            }
+            print(
+                f"         iterations per accepted step: position {per['position']:.3f}  "
+                f"velocity {per['velocity']:.3f}  acceleration {per['acceleration']:.3f}  "
+                f"(totals {int(ds['lee_total_iterations_position'])} / "
+                f"{int(ds['lee_total_iterations_velocity'])} / "
+                f"{int(ds['lee_total_iterations_acceleration'])}); RKN passes {int(ds['lee_step_passes'])}; "
+                f"eps1 {float(ds['lee_eps1']):.4f}; A_n builds {int(ds['lee_matrix_builds'])}"
+            )
     print(f"lee / reduced wall-time ratio: {best['lee'] / best['reduced']:.2f} (target <= 3)")
     for name in ("lee n=1", "lee A_n every step"):
         print(f"{name} / reduced wall-time ratio: {best[name] / best['reduced']:.2f}")

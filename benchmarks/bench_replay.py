@@ -1,4 +1,4 @@
-"""Cost of the rerun recording of paper_step against its solve time (issue 5 target: < 20 %).
+"""Cost of the rerun recording of paper_step against its solve time (target: < 20 %).
 
     python benchmarks/bench_replay.py [--repeat 5] [--duration 0.5]
 
@@ -31,22 +31,30 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--duration", type=float, default=0.5)
-    ap.add_argument("--overwrite", action="store_true",
-                    help="write over the same file every time (ext4 charges the old file's replacement)")
+    ap.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="write over the same file every time (ext4 charges the old file's replacement)",
+    )
     args = ap.parse_args(argv)
-    tb.simulate(tb.Scenario.paper(duration=0.01))          # compile / load the numba cache
+    tb.simulate(tb.Scenario.paper(duration=0.01))  # compile / load the numba cache
     ds = tb.simulate(tb.Scenario.paper(duration=args.duration))
     solve = float(ds.attrs["solve_time"])
     n = ds.sizes["time"]
-    print(f"paper_step {args.duration} s: {n} output frames, solve time {solve * 1e3:.1f} ms "
-          f"(wall {ds.attrs['wall_time'] * 1e3:.1f} ms)")
+    print(
+        f"paper_step {args.duration} s: {n} output frames, solve time {solve * 1e3:.1f} ms "
+        f"(wall {ds.attrs['wall_time'] * 1e3:.1f} ms)"
+    )
     ok = True
     with tempfile.TemporaryDirectory() as d:
         p = Path(d) / "recording.rrd"
         t0 = time.perf_counter()
         write_recording(ds, p)
         cold = time.perf_counter() - t0
-        print(f"first write in this process (imports, Arrow set-up): {cold * 1e3:.1f} ms = {100 * cold / solve:.1f} %")
+        print(
+            f"first write in this process (imports, Arrow set-up): {cold * 1e3:.1f} ms = "
+            f"{100 * cold / solve:.1f} %"
+        )
         print(f"{'every':>5} {'frames':>7} {'median ms':>10} {'min ms':>8} {'% of solve':>11} {'MB':>6}")
         for every in (1, 2, 5, 10):
             times = []
@@ -58,11 +66,16 @@ def main(argv=None):
                 times.append(time.perf_counter() - t0)
             med = statistics.median(times)
             frames = len(range(0, n, every)) + (1 if (n - 1) % every else 0)
-            print(f"{every:5d} {frames:7d} {med * 1e3:10.1f} {min(times) * 1e3:8.1f} {100 * med / solve:10.1f}% "
-                  f"{p.stat().st_size / 1e6:6.2f}")
+            print(
+                f"{every:5d} {frames:7d} {med * 1e3:10.1f} {min(times) * 1e3:8.1f} "
+                f"{100 * med / solve:10.1f}% {p.stat().st_size / 1e6:6.2f}"
+            )
             if every == 1:
                 ok = med < TARGET * solve
-    print(f"target: recording (every=1, median) < {100 * TARGET:.0f} % of the solve time: {'met' if ok else 'MISSED'}")
+    print(
+        f"target: recording (every=1, median) < {100 * TARGET:.0f} % of the solve time: "
+        f"{'met' if ok else 'MISSED'}"
+    )
     return 0 if ok else 1
 
 

@@ -23,10 +23,27 @@ KINDS = {
     "dop853": ({"method": "dop853"}, 10),
     "lee": ({"solver": "lee"}, 5),
     "damped": ({"preset": "damped"}, 10),
-    "closed": ({"preset": "damped", "duration": 0.1, "track": {"layout": "closed"}, "drive": {"kind": "speed"},
-                "contact": {"friction": 0.6}}, 3),
-    "soil": ({"preset": "damped", "duration": 0.1, "speed": 3.0, "terrain": {"kind": "flat", "soil": "lete_sand"},
-              "track": {"layout": "closed"}, "drive": {"kind": "speed"}}, 3),
+    "closed": (
+        {
+            "preset": "damped",
+            "duration": 0.1,
+            "track": {"layout": "closed"},
+            "drive": {"kind": "speed"},
+            "contact": {"friction": 0.6},
+        },
+        3,
+    ),
+    "soil": (
+        {
+            "preset": "damped",
+            "duration": 0.1,
+            "speed": 3.0,
+            "terrain": {"kind": "flat", "soil": "lete_sand"},
+            "track": {"layout": "closed"},
+            "drive": {"kind": "speed"},
+        },
+        3,
+    ),
 }
 
 CHILD = """
@@ -42,8 +59,12 @@ print(json.dumps({"solve": best, "file": tb.__file__}))
 
 
 def solve_time(root, kind):
-    out = subprocess.run([sys.executable, "-c", CHILD, str(root), json.dumps(KINDS[kind])], check=True,
-                         capture_output=True, text=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", CHILD, str(root), json.dumps(KINDS[kind])],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
     got = json.loads(out.strip().splitlines()[-1])
     assert Path(got["file"]).resolve().is_relative_to(Path(root).resolve()), got["file"]
     return got["solve"]
@@ -58,8 +79,11 @@ def main():
     kinds = args.kinds.split(",")
     with tempfile.TemporaryDirectory() as tmp:
         base = Path(tmp) / "base"
-        subprocess.run(["git", "-C", str(HERE), "worktree", "add", "--detach", str(base), args.base], check=True,
-                       capture_output=True)
+        subprocess.run(
+            ["git", "-C", str(HERE), "worktree", "add", "--detach", str(base), args.base],
+            check=True,
+            capture_output=True,
+        )
         try:
             best = {(k, w): float("inf") for k in kinds for w in ("this", "base")}
             for r in range(args.rounds):
@@ -72,7 +96,9 @@ def main():
     print(f"solve time, best of {args.rounds} rounds; this checkout against {args.base}")
     print(f"{'kind':8} {'this (s)':>10} {'base (s)':>10} {'this/base':>10}")
     for k in kinds:
-        print(f"{k:8} {best[k, 'this']:10.4f} {best[k, 'base']:10.4f} {best[k, 'this'] / best[k, 'base']:10.3f}")
+        print(
+            f"{k:8} {best[k, 'this']:10.4f} {best[k, 'base']:10.4f} {best[k, 'this'] / best[k, 'base']:10.3f}"
+        )
 
 
 if __name__ == "__main__":

@@ -4,8 +4,8 @@
                                      [--reference RESULTS_DIR]
 
 Every figure is a whole `trackbench study run` command in a fresh process on a fresh results
-folder (as a user runs it), the numba cache warm (one warm-up command first). The machine may be shared, so the
-commands compared are alternated run by run and the medians compared.
+folder (as a user runs it), the numba cache warm (one warm-up command first). The machine may be
+shared, so the commands compared are alternated run by run and the medians compared.
 
 sweep    the shipped studies/speed_sweep.toml (15 runs of 0.5 s) with 1 and 2 workers:
          whole-command speed-up, sum of the solve times / (2 x wall) with 2 workers, and the
@@ -46,8 +46,13 @@ def command(cwd, study, *args):
     first run: no file replaced); returns its wall time (s)."""
     shutil.rmtree(cwd / "results" / Path(study).stem, ignore_errors=True)
     t = time.perf_counter()
-    r = subprocess.run(CLI + ["study", "run", study, *args], cwd=cwd, stdout=subprocess.DEVNULL,
-                       stderr=subprocess.PIPE, text=True)
+    r = subprocess.run(
+        CLI + ["study", "run", study, *args],
+        cwd=cwd,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     wall = time.perf_counter() - t
     if r.returncode != 0:
         raise SystemExit(f"study run {study} {' '.join(args)} failed: {r.stderr[-2000:]}")
@@ -107,6 +112,7 @@ def sweep_case(cwd, workers, extra=()):
         wall = command(cwd, "speed_sweep.toml", "-w", str(workers), *extra)
         med, worst, solve = overhead(records(cwd / "results" / "speed_sweep"))
         return {"wall": wall, "solve": solve, "med": med, "max": worst}
+
     return fn
 
 
@@ -121,13 +127,20 @@ def part_sweep(cwd, repeat):
     print(f"\n== speed_sweep, whole command, {repeat} alternating pairs (median [min, max])")
     for w in (1, 2):
         walls = [r["wall"] for r in res[w]]
-        print(f"{w} worker{'s' if w > 1 else ' '}: {statistics.median(walls):.2f} s [{min(walls):.2f}, {max(walls):.2f}]; "
-              f"solve total {med(res[w], 'solve'):.2f} s; per-run overhead outside the solve (run.json): "
-              f"median {100 * med(res[w], 'med'):.0f} %, largest {100 * max(r['max'] for r in res[w]):.0f} %")
-    print(f"speed-up 2 vs 1 workers: median {statistics.median(ratios):.2f}x [{min(ratios):.2f}, {max(ratios):.2f}] "
-          f"(target >= 1.8x)")
-    print(f"sum of solve times / (2 x wall), 2 workers: median {statistics.median(eff):.2f} "
-          f"[{min(eff):.2f}, {max(eff):.2f}] (target >= 0.4)")
+        print(
+            f"{w} worker{'s' if w > 1 else ' '}: {statistics.median(walls):.2f} s [{min(walls):.2f}, "
+            f"{max(walls):.2f}]; solve total {med(res[w], 'solve'):.2f} s; per-run overhead outside the "
+            f"solve (run.json): median {100 * med(res[w], 'med'):.0f} %, largest "
+            f"{100 * max(r['max'] for r in res[w]):.0f} %"
+        )
+    print(
+        f"speed-up 2 vs 1 workers: median {statistics.median(ratios):.2f}x [{min(ratios):.2f}, "
+        f"{max(ratios):.2f}] (target >= 1.8x)"
+    )
+    print(
+        f"sum of solve times / (2 x wall), 2 workers: median {statistics.median(eff):.2f} "
+        f"[{min(eff):.2f}, {max(eff):.2f}] (target >= 0.4)"
+    )
 
 
 def folder_bytes(run):
@@ -138,6 +151,7 @@ def as_before(src, dst):
     """A copy of the study folder ``src`` whose timeseries.nc are written as before trackbench.storage
     (xarray's to_netcdf, uncompressed): the yardstick for size and reading time."""
     import xarray as xr
+
     shutil.copytree(src, dst)
     for p in dst.glob("runs/*/timeseries.nc"):
         ds = xr.load_dataset(p).drop_encoding()
@@ -156,6 +170,7 @@ def reading_case(folder):
         ds.chassis_y.load()
         ds.close()
         return {"summary": t1 - t, "dataset": time.perf_counter() - t1}
+
     return fn
 
 
@@ -169,32 +184,52 @@ def part_storage(cwd, repeat):
     shutil.rmtree(before, ignore_errors=True)
     as_before(full, before)
     print("\n== storage of the speed sweep (largest run folder; whole study)")
-    for name, folder in (("before (xarray, uncompressed)", before), ("full (default)", full), ("compact", compact)):
+    for name, folder in (
+        ("before (xarray, uncompressed)", before),
+        ("full (default)", full),
+        ("compact", compact),
+    ):
         sizes = [folder_bytes(r) for r in folder.glob("runs/*")]
         nc = max(p.stat().st_size for p in folder.glob("runs/*/timeseries.nc"))
         rrd = max((p.stat().st_size for p in folder.glob("runs/*/recording.rrd")), default=0)
-        print(f"{name:30s} largest folder {max(sizes) / 1e6:.2f} MB (timeseries.nc up to {nc / 1e6:.2f} MB, "
-              f"recording up to {rrd / 1e6:.2f} MB); study {sum(sizes) / 1e6:.0f} MB")
-    res = alternate(repeat, {"before": reading_case(before), "full": reading_case(full), "compact": reading_case(compact)})
+        print(
+            f"{name:30s} largest folder {max(sizes) / 1e6:.2f} MB (timeseries.nc up to {nc / 1e6:.2f} MB, "
+            f"recording up to {rrd / 1e6:.2f} MB); study {sum(sizes) / 1e6:.0f} MB"
+        )
+    res = alternate(
+        repeat, {"before": reading_case(before), "full": reading_case(full), "compact": reading_case(compact)}
+    )
     print(f"reading, median of {repeat} alternating: open_study / open_study_dataset + chassis_y.load()")
     for name in res:
-        print(f"  {name:8s} {1e3 * med(res[name], 'summary'):6.1f} ms / {1e3 * med(res[name], 'dataset'):6.1f} ms")
+        print(
+            f"  {name:8s} {1e3 * med(res[name], 'summary'):6.1f} ms / "
+            f"{1e3 * med(res[name], 'dataset'):6.1f} ms"
+        )
     return full
 
 
 def compare(a, b):
     """Differences between the sweep's results in folders a and b (summary numbers, arrays)."""
     import xarray as xr
+
     da, db = pd.read_csv(a / "summary.csv"), pd.read_csv(b / "summary.csv")
     if list(da.run_id) != list(db.run_id):
         return ["the run ids differ"]
-    bad = [f"summary.csv {c}" for c in da.columns if c not in ("wall_time", "solve_time") and not da[c].equals(db[c])]
+    bad = [
+        f"summary.csv {c}"
+        for c in da.columns
+        if c not in ("wall_time", "solve_time") and not da[c].equals(db[c])
+    ]
     for rid in da.run_id:
         x, y = (xr.load_dataset(f / "runs" / rid / "timeseries.nc") for f in (a, b))
         if set(x.variables) != set(y.variables):
             bad.append(f"{rid}: variables differ")
-        bad += [f"{rid} {k}" for k in x.variables if k in y.variables and not (
-            x[k].dtype == y[k].dtype and np.array_equal(x[k].values, y[k].values, equal_nan=True))]
+        bad += [
+            f"{rid} {k}"
+            for k in x.variables
+            if k in y.variables
+            and not (x[k].dtype == y[k].dtype and np.array_equal(x[k].values, y[k].values, equal_nan=True))
+        ]
     return bad
 
 
@@ -202,16 +237,24 @@ def part_reference(cwd, reference):
     full = cwd / "results" / "speed_sweep"
     command(cwd, "speed_sweep.toml", "-w", "2")
     bad = compare(Path(reference), full)
-    print(f"\n== results against {reference}: " + ("summary numbers and every array bit for bit the same"
-                                                     if not bad else f"{len(bad)} differences: {bad[:10]}"))
+    print(
+        f"\n== results against {reference}: "
+        + (
+            "summary numbers and every array bit for bit the same"
+            if not bad
+            else f"{len(bad)} differences: {bad[:10]}"
+        )
+    )
 
 
 def part_dask(cwd, repeat):
     res = alternate(repeat, {"pool": sweep_case(cwd, 2), "dask": sweep_case(cwd, 2, ("--executor", "dask"))})
     ratios = [d["wall"] / p["wall"] for p, d in zip(res["pool"], res["dask"])]
     print(f"\n== dask LocalCluster (2 worker processes) against the process pool (2 workers), {repeat} pairs")
-    print(f"pool {med(res['pool'], 'wall'):.2f} s, dask {med(res['dask'], 'wall'):.2f} s: dask / pool median "
-          f"{statistics.median(ratios):.2f} [{min(ratios):.2f}, {max(ratios):.2f}] (target <= 1.3)")
+    print(
+        f"pool {med(res['pool'], 'wall'):.2f} s, dask {med(res['dask'], 'wall'):.2f} s: dask / pool median "
+        f"{statistics.median(ratios):.2f} [{min(ratios):.2f}, {max(ratios):.2f}] (target <= 1.3)"
+    )
 
 
 LARGE = """[study]
@@ -227,6 +270,7 @@ speed = {{ start = 5.0, stop = {stop}, step = 0.05 }}
 def sample_memory(proc, out, every=0.2):
     """(seconds, runs finished, RSS of the command in MB) while ``proc`` runs."""
     import psutil
+
     p, rows, t0 = psutil.Process(proc.pid), [], time.perf_counter()
     while proc.poll() is None:
         try:
@@ -243,20 +287,31 @@ def part_large(cwd, n=200):
     out = cwd / "results" / "large"
     shutil.rmtree(out, ignore_errors=True)
     t = time.perf_counter()
-    proc = subprocess.Popen(CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    proc = subprocess.Popen(
+        CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
     rows = sample_memory(proc, out)
     wall = time.perf_counter() - t
     recs = records(out)
     span = max(r["finished_unix"] for r in recs) - min(r["started_unix"] for r in recs)
     med_o, max_o, solve = overhead(recs)
-    print(f"\n== {n}-run study (0.5 s runs, 2 workers, recordings off): exit {proc.returncode}, {len(recs)} runs")
-    print(f"whole command {wall:.1f} s: {n / wall:.2f} runs/s; first run start to last run end {span:.1f} s: "
-          f"{n / span:.2f} runs/s; solve total {solve:.1f} s (sum / (2 x wall) = {solve / (2 * wall):.2f}); "
-          f"per-run overhead median {100 * med_o:.0f} %")
-    marks = [rows[min(range(len(rows)), key=lambda i: abs(rows[i][1] - k))] for k in (n // 10, n // 2, n * 9 // 10)]
-    print("memory of the command (main process) as runs accumulate: " + ", ".join(
-        f"{r[1]} runs {r[2]:.0f} MB" for r in marks) + f"; peak {max(r[2] for r in rows):.0f} MB")
+    print(
+        f"\n== {n}-run study (0.5 s runs, 2 workers, recordings off): exit {proc.returncode}, "
+        f"{len(recs)} runs"
+    )
+    print(
+        f"whole command {wall:.1f} s: {n / wall:.2f} runs/s; first run start to last run end {span:.1f} s: "
+        f"{n / span:.2f} runs/s; solve total {solve:.1f} s (sum / (2 x wall) = {solve / (2 * wall):.2f}); "
+        f"per-run overhead median {100 * med_o:.0f} %"
+    )
+    marks = [
+        rows[min(range(len(rows)), key=lambda i: abs(rows[i][1] - k))] for k in (n // 10, n // 2, n * 9 // 10)
+    ]
+    print(
+        "memory of the command (main process) as runs accumulate: "
+        + ", ".join(f"{r[1]} runs {r[2]:.0f} MB" for r in marks)
+        + f"; peak {max(r[2] for r in rows):.0f} MB"
+    )
     part_summary_time(out, n)
 
 
@@ -264,6 +319,7 @@ def part_summary_time(out, n):
     """write_summary (summary.csv + .parquet from every run.json) for the first n/8 .. n runs,
     best of 5, and the straight line a + b x runs through them."""
     from trackbench.study.summary import _study_of, write_summary
+
     study = _study_of(out)
     runs, ks, best = study.runs, [n // 8, n // 4, n // 2, n], []
     for k in ks:
@@ -276,17 +332,26 @@ def part_summary_time(out, n):
         best.append(min(times))
     b, a = np.polyfit(ks, best, 1)
     worst = max(abs(a + b * k - t) / t for k, t in zip(ks, best))
-    print("write_summary, best of 5: " + "; ".join(f"{k} runs {1e3 * t:.0f} ms" for k, t in zip(ks, best))
-          + f"; line {1e3 * a:.0f} ms + {1e3 * b:.2f} ms per run (largest deviation {100 * worst:.0f} %)")
+    print(
+        "write_summary, best of 5: "
+        + "; ".join(f"{k} runs {1e3 * t:.0f} ms" for k, t in zip(ks, best))
+        + f"; line {1e3 * a:.0f} ms + {1e3 * b:.2f} ms per run (largest deviation {100 * worst:.0f} %)"
+    )
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5, help="alternating repeats of each comparison")
     ap.add_argument("--parts", default="sweep,storage,dask,large")
-    ap.add_argument("--reference", help="results folder of the speed sweep from another version (bit for bit)")
-    ap.add_argument("--quiet-wait", type=float, default=0.0,
-                    help="before each round, wait up to this many seconds for an idle machine")
+    ap.add_argument(
+        "--reference", help="results folder of the speed sweep from another version (bit for bit)"
+    )
+    ap.add_argument(
+        "--quiet-wait",
+        type=float,
+        default=0.0,
+        help="before each round, wait up to this many seconds for an idle machine",
+    )
     args = ap.parse_args()
     QUIET["limit"] = args.quiet_wait
     parts = args.parts.split(",")
@@ -294,7 +359,7 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         cwd = Path(tmp)
         shutil.copy(REPO / "studies" / "speed_sweep.toml", cwd / "speed_sweep.toml")
-        command(cwd, "speed_sweep.toml", "-w", "2")   # warm-up: numba cache and page cache
+        command(cwd, "speed_sweep.toml", "-w", "2")  # warm-up: numba cache and page cache
         if "sweep" in parts:
             part_sweep(cwd, args.repeat)
         if "storage" in parts:
@@ -306,8 +371,10 @@ def main():
         if "large" in parts:
             part_large(cwd)
     seen = [f"{x:.2f}" for x in QUIET["seen"] if x is not None]
-    print(f"load average after: {os.getloadavg()[0]:.2f}" + (f"; idle fraction before each round: {', '.join(seen)}"
-                                                             if seen else ""))
+    print(
+        f"load average after: {os.getloadavg()[0]:.2f}"
+        + (f"; idle fraction before each round: {', '.join(seen)}" if seen else "")
+    )
 
 
 if __name__ == "__main__":

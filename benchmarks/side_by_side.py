@@ -20,6 +20,8 @@ def best_walls(variants, repeats):
             ds = tb.simulate(sc)
             wall = time.perf_counter() - t
             best[name] = min(best[name], wall)
-            print(f"  {name}: {wall:.2f} s wall, solve {ds.attrs['solve_time']:.2f} s, steps {ds.attrs['steps']} "
-                  f"(+{ds.attrs['rejected_steps']} rejected), {ds.attrs['status']}")
+            print(
+                f"  {name}: {wall:.2f} s wall, solve {ds.attrs['solve_time']:.2f} s, steps "
+                f"{ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected), {ds.attrs['status']}"
+            )
     return best

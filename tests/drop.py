@@ -10,8 +10,8 @@ import math
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from trackbench.model.contact_force import normal_force
-from trackbench.model.contact_laws import DAMPINGS, LAWS, damping_ratio_for_restitution, restitution_factor
+from trackbench.model.contact.laws import DAMPINGS, LAWS, damping_ratio_for_restitution, restitution_factor
+from trackbench.model.contact.laws_jit import normal_force
 
 PIN_MASS = 20.0
 K = 1e8
@@ -34,10 +34,12 @@ def drop(damping, e=1.0, zeta=0.0, n=1.0, ramp=2e-4, k=K, m=PIN_MASS, v=V):
 
     def leaves(t, s):
         return s[0] if t > 0.0 else 1.0
+
     leaves.terminal = True
     leaves.direction = -1
-    r = solve_ivp(rhs, (0.0, 0.05), [0.0, v], method="DOP853", rtol=1e-11, atol=1e-15, events=leaves,
-                  max_step=2e-6)
+    r = solve_ivp(
+        rhs, (0.0, 0.05), [0.0, v], method="DOP853", rtol=1e-11, atol=1e-15, events=leaves, max_step=2e-6
+    )
     return -r.y_events[0][0][1] / v
 
 
@@ -56,24 +58,30 @@ def restitution_law_closed_form(chi):
     -u/(1 + chi u) until the force vanishes (u = -1/chi) or the pad is free (u = -e)."""
     if chi <= 0.0:
         return 1.0
-    stored = 1.0 / chi - math.log1p(chi) / chi ** 2
+    stored = 1.0 / chi - math.log1p(chi) / chi**2
 
     def returned(e):
-        return -e / chi - math.log1p(-chi * e) / chi ** 2
+        return -e / chi - math.log1p(-chi * e) / chi**2
+
     top = 1.0 / chi if chi > 1.0 else 1.0
     if chi > 1.0 and returned(top * (1 - 1e-15)) <= stored:
-        return top   # the force reaches zero first: the pin leaves at u = -1/chi
+        return top  # the force reaches zero first: the pin leaves at u = -1/chi
     return brentq(lambda e: returned(e) - stored, 0.0, min(top, 1.0) * (1 - 1e-15), xtol=1e-14)
 
 
 def table():
-    rows = ["| law | n | e requested | e measured | closed form | measured / requested |",
-            "| --- | --- | --- | --- | --- | --- |"]
+    rows = [
+        "| law | n | e requested | e measured | closed form | measured / requested |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
     for e in (0.2, 0.5, 0.75, 0.9):
         z = damping_ratio_for_restitution(e)
         for ramp, label in ((1e-9, "viscous (no ramp)"), (2e-4, "viscous (ramp 0.2 mm)")):
             got = drop("viscous", zeta=z, ramp=ramp)
-            rows.append(f"| {label}, zeta {z:.4f} | 1 | {e} | {got:.4f} | {viscous_closed_form(z):.4f} | {got / e:.3f} |")
+            rows.append(
+                f"| {label}, zeta {z:.4f} | 1 | {e} | {got:.4f} | {viscous_closed_form(z):.4f} | "
+                f"{got / e:.3f} |"
+            )
     for law in ("hunt_crossley", "lankarani_nikravesh", "flores"):
         for n in (1.0, 1.5):
             for e in (0.2, 0.5, 0.75, 0.9):

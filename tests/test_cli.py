@@ -35,12 +35,32 @@ def test_run_that_cannot_start_says_why_in_one_line(tmp_path):
     """A soil too soft for the vehicle: no equilibrium, a one-line error that says how deep
     it would sink, exit code 1, nothing written."""
     from typer.testing import CliRunner
+
     from trackbench.cli import app
+
     out = tmp_path / "out"
-    r = CliRunner().invoke(app, ["run", "--set", "terrain.kind=flat", "--set", "terrain.soil=heavy_clay",
-                                 "--set", "speed=0", "--duration", "0.01", "--out", str(out)])
+    r = CliRunner().invoke(
+        app,
+        [
+            "run",
+            "--set",
+            "terrain.kind=flat",
+            "--set",
+            "terrain.soil=heavy_clay",
+            "--set",
+            "speed=0",
+            "--duration",
+            "0.01",
+            "--out",
+            str(out),
+        ],
+    )
     assert r.exit_code == 1
     # on a cold numba cache (a fresh clone) the compile notice comes first: it is not the error
     lines = [x for x in r.output.strip().splitlines() if not x.startswith("compiling the model")]
-    assert len(lines) == 1 and lines[0].startswith("error: static equilibrium not found") and "track.width" in lines[0]
+    assert (
+        len(lines) == 1
+        and lines[0].startswith("error: static equilibrium not found")
+        and "track.width" in lines[0]
+    )
     assert not out.exists() or not any(out.iterdir())

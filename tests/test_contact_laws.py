@@ -3,12 +3,11 @@
 import math
 
 import numpy as np
-
 import pytest
+from drop import drop, restitution_law_closed_form, viscous_closed_form
 
 import trackbench as tb
-from drop import drop, restitution_law_closed_form, viscous_closed_form
-from trackbench.model.contact_laws import DAMPINGS, damping_ratio_for_restitution, restitution_factor
+from trackbench.model.contact.laws import DAMPINGS, damping_ratio_for_restitution, restitution_factor
 from trackbench.presets import PAD_RESTITUTION
 
 E = (0.2, 0.5, 0.75, 0.9)
@@ -45,22 +44,30 @@ def test_power_law_vehicle_starts_from_equilibrium(k):
     """A power law has no stiffness at zero compression, where the equilibrium's Newton
     iteration starts: it is reached by continuation from the linear law."""
     from trackbench.simulate import equilibrium
-    sc = tb.Scenario.paper(**{"contact.law": "power", "contact.exponent": 1.5, "track.wheel_stiffness": k,
-                              "track.ground_stiffness": k})
+
+    sc = tb.Scenario.paper(
+        **{
+            "contact.law": "power",
+            "contact.exponent": 1.5,
+            "track.wheel_stiffness": k,
+            "track.ground_stiffness": k,
+        }
+    )
     eq = equilibrium(sc)
     assert eq.residual < 1e-6 * eq.weight
     assert eq.ground_force == pytest.approx(eq.weight, rel=1e-9)
     # softer pads than the paper's at these loads (compressions of 0.5-5 mm instead of 0.4 mm)
     linear = equilibrium(tb.Scenario.paper())
-    assert eq.q[1] < linear.q[1]   # the chassis sits lower
+    assert eq.q[1] < linear.q[1]  # the chassis sits lower
 
 
 @pytest.fixture(scope="module")
 def sliding():
     """The paper's vehicle on flat ground with ground friction mu = 0.3: its track is bolted to
     the chassis, so the whole bottom run slides over the ground at the vehicle's speed."""
-    return tb.simulate(tb.Scenario.paper(**{"terrain": {"kind": "flat"}, "contact.friction": 0.3,
-                                            "duration": 0.3}))
+    return tb.simulate(
+        tb.Scenario.paper(**{"terrain": {"kind": "flat"}, "contact.friction": 0.3, "duration": 0.3})
+    )
 
 
 def test_sliding_track_feels_coulomb_friction(sliding):
@@ -77,23 +84,25 @@ def test_sliding_track_feels_coulomb_friction(sliding):
 
 
 def test_regularised_friction_law():
-    from trackbench.model.contact_force import friction
+    from trackbench.model.contact.laws_jit import friction
+
     assert friction(0.5, 0.01, 1000.0, 10.0) == pytest.approx(-500.0, rel=1e-6)
     assert friction(0.5, 0.01, 1000.0, -10.0) == pytest.approx(500.0, rel=1e-6)
     assert friction(0.5, 0.01, 1000.0, 0.0) == 0.0
-    assert abs(friction(0.5, 0.01, 1000.0, 0.001)) < 0.1 * 500.0   # below v_eps: a viscous law
+    assert abs(friction(0.5, 0.01, 1000.0, 0.001)) < 0.1 * 500.0  # below v_eps: a viscous law
 
 
 def test_bristle_friction_law():
     """A spring and dashpot to the anchor, capped at mu p = k x limit either way."""
-    from trackbench.model.contact_force import bristle
+    from trackbench.model.contact.laws_jit import bristle
+
     k, c = 2e7, 4e4
-    assert bristle(1e-3, k, c, 1e-4, 0.0) == pytest.approx(-2e3)          # stuck: the spring
+    assert bristle(1e-3, k, c, 1e-4, 0.0) == pytest.approx(-2e3)  # stuck: the spring
     assert bristle(1e-3, k, c, 1e-4, 0.01) == pytest.approx(-2e3 - 400.0)  # and its dashpot
-    assert bristle(1e-3, k, c, 5e-3, 0.0) == pytest.approx(-2e4)          # beyond the limit: mu p
+    assert bristle(1e-3, k, c, 5e-3, 0.0) == pytest.approx(-2e4)  # beyond the limit: mu p
     assert bristle(1e-3, k, c, -5e-3, 0.0) == pytest.approx(2e4)
-    assert bristle(1e-3, k, c, 0.0, -10.0) == pytest.approx(2e4)          # sliding fast: mu p
-    assert bristle(0.0, k, c, 1e-4, 1.0) == 0.0                            # no normal force, no friction
+    assert bristle(1e-3, k, c, 0.0, -10.0) == pytest.approx(2e4)  # sliding fast: mu p
+    assert bristle(0.0, k, c, 1e-4, 1.0) == 0.0  # no normal force, no friction
 
 
 def test_bristle_anchor_moves_only_as_the_rules_say():
@@ -104,22 +113,30 @@ def test_bristle_anchor_moves_only_as_the_rules_say():
     the ground forgets its anchor."""
     from collections import namedtuple
 
-    from trackbench.model import layout as L
-    from trackbench.model.contact_force import bristle
-    from trackbench.model.contact_laws import FRICTION_BRISTLE
-    from trackbench.model.grip import bristle_stretch, remember_grip
-    from trackbench.model.layout import G_FORCE, G_LIMIT, G_SPEED, G_TX, G_TY, N_GRIP
+    from trackbench.model.contact.laws import FRICTION_BRISTLE
+    from trackbench.model.contact.laws_jit import bristle
+    from trackbench.model.core import indices as L
+    from trackbench.model.core.indices import G_FORCE, G_LIMIT, G_SPEED, G_TX, G_TY, N_GRIP
+    from trackbench.model.ground.grip import bristle_stretch, remember_grip
+
     M = namedtuple("M", ["par", "touchdown"])
     W = namedtuple("W", ["apos", "grip"])
     k, c, limit = 2e7, 4e4, 1e-3
     par = np.zeros(L.N_PAR)
-    par[L.P_FRICTION], par[L.P_FRICTION_LAW], par[L.P_BRISTLE_K], par[L.P_BRISTLE_C] = 0.5, FRICTION_BRISTLE, k, c
+    par[L.P_FRICTION], par[L.P_FRICTION_LAW], par[L.P_BRISTLE_K], par[L.P_BRISTLE_C] = (
+        0.5,
+        FRICTION_BRISTLE,
+        k,
+        c,
+    )
     nan = np.nan
-    s = math.sqrt(0.5)       # pin 3 on a 45 deg slope: its tangent (s, s)
+    s = math.sqrt(0.5)  # pin 3 on a 45 deg slope: its tangent (s, s)
     apos = np.array([[1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0], [5.0, 0.0]])
-    anchor = np.array([[nan, nan], [1.9995, 0.0], [3.0 - 1.1e-3, 0.0], [4.0 - 0.01 * s, -0.01 * s], [4.9, 0.0]])
+    anchor = np.array(
+        [[nan, nan], [1.9995, 0.0], [3.0 - 1.1e-3, 0.0], [4.0 - 0.01 * s, -0.01 * s], [4.9, 0.0]]
+    )
     tangent = [(1.0, 0.0), (1.0, 0.0), (1.0, 0.0), (s, s), (nan, nan)]
-    speed = [0.0, 0.01, -0.3, 0.2, nan]   # pin 2: stretched beyond the limit, moving back: force below mu p
+    speed = [0.0, 0.01, -0.3, 0.2, nan]  # pin 2: stretched beyond the limit, moving back: force below mu p
     grip = np.full((5, N_GRIP), nan)
     for b in range(4):
         grip[b, G_LIMIT], (grip[b, G_TX], grip[b, G_TY]), grip[b, G_SPEED] = limit, tangent[b], speed[b]
@@ -127,24 +144,34 @@ def test_bristle_anchor_moves_only_as_the_rules_say():
         grip[b, G_FORCE] = bristle(limit, k, c, d, speed[b])
     before = anchor.copy()
     remember_grip(M(par, anchor), W(apos, grip))
-    np.testing.assert_allclose(anchor[0], [1.0, 0.0])               # touched down: anchored here
-    np.testing.assert_array_equal(anchor[1], before[1])             # within the limit: kept
+    np.testing.assert_allclose(anchor[0], [1.0, 0.0])  # touched down: anchored here
+    np.testing.assert_array_equal(anchor[1], before[1])  # within the limit: kept
     assert abs(grip[2, G_FORCE]) < k * limit
-    np.testing.assert_array_equal(anchor[2], before[2])             # below mu p though stretched: kept
-    assert grip[3, G_FORCE] == -k * limit                           # sliding: at mu p
+    np.testing.assert_array_equal(anchor[2], before[2])  # below mu p though stretched: kept
+    assert grip[3, G_FORCE] == -k * limit  # sliding: at mu p
     after = bristle(limit, k, c, bristle_stretch(3, apos, anchor, s, s), speed[3])
-    assert after == pytest.approx(grip[3, G_FORCE], rel=1e-9)       # dragged: the same force
+    assert after == pytest.approx(grip[3, G_FORCE], rel=1e-9)  # dragged: the same force
     moved = anchor[3] - before[3]
-    assert moved[0] * s - moved[1] * s == pytest.approx(0.0, abs=1e-15)   # along the slope
-    assert (apos[3] - anchor[3]) @ [s, s] < 0.01                    # towards the pin
-    assert np.isnan(anchor[4]).all()                                # off the ground: forgotten
+    assert moved[0] * s - moved[1] * s == pytest.approx(0.0, abs=1e-15)  # along the slope
+    assert (apos[3] - anchor[3]) @ [s, s] < 0.01  # towards the pin
+    assert np.isnan(anchor[4]).all()  # off the ground: forgotten
 
 
 def test_bristle_sliding_track_feels_coulomb_friction():
     """Every pin sliding at ~10 m/s: the bristle law gives mu p exactly, like the regularised
     law far above v_eps."""
-    ds = tb.simulate(tb.Scenario.paper(**{"terrain": {"kind": "flat"}, "contact.friction": 0.3,
-                                          "contact.friction_law": "bristle", "duration": 0.05}))
+    ds = tb.simulate(
+        tb.Scenario.paper(
+            **{
+                "terrain": {"kind": "flat"},
+                "contact.friction": 0.3,
+                "contact.friction_law": "bristle",
+                "duration": 0.05,
+            }
+        )
+    )
     late = ds.time.values > 0.01
-    np.testing.assert_allclose(ds.ground_force_x.values[late] / ds.ground_force_y.values[late], -0.3, rtol=1e-9)
+    np.testing.assert_allclose(
+        ds.ground_force_x.values[late] / ds.ground_force_y.values[late], -0.3, rtol=1e-9
+    )
     assert float(abs(ds.energy_residual).max()) < 1e-6

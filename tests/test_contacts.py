@@ -1,17 +1,17 @@
-"""Each contact case of the spec against hand-computed geometry, Eq. (7), Eq. (8)."""
+"""Each contact case of docs/model.md against hand-computed geometry, Eq. (7), Eq. (8)."""
 
 import numpy as np
 import pytest
 
-from trackbench.model import layout as L
-from trackbench.model.bundles import arm_table, model_arrays, work_arrays
-from trackbench.model.kernels import track_loads
-from trackbench.model.parameters import pack, paper_contact, paper_track, paper_vehicle
-from trackbench.model.terrain import ground_from_points
+from trackbench.model.core import indices as L
+from trackbench.model.core.bundles import arm_table, model_arrays, work_arrays
+from trackbench.model.dynamics.track_loads import track_loads
+from trackbench.model.ground.terrain import ground_from_points
+from trackbench.model.vehicle.parameters import pack, paper_contact, paper_track, paper_vehicle
 from trackbench.status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 
-K = 1e8          # k_w = k_g of the paper
-RHO = 0.30       # wheel radius 0.28 + pad 0.02
+K = 1e8  # k_w = k_g of the paper
+RHO = 0.30  # wheel radius 0.28 + pad 0.02
 HG = 0.02
 
 
@@ -34,7 +34,7 @@ def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None, geo
     diag = np.zeros(L.n_diag(len(wheels), len(pins) - 1))
     track_loads(w, m, diag)
     fpin, fwheel = w.fpin.copy(), w.fwheel.copy()
-    tension = diag[L.diag_tension(len(wheels)):]
+    tension = diag[L.diag_tension(len(wheels)) :]
     # remove the tension pull so only contact forces remain
     for b, T in enumerate(tension):
         t = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
@@ -54,16 +54,16 @@ def test_tension_law_eq8_both_ways():
     _, _, diag, T = loads(pins, [[5.0, 5.0]])
     assert T[0] == pytest.approx(8e6 * (0.2 - 0.19))
     assert T[1] == pytest.approx(8e6 * (0.18 - 0.19))  # negative: it pushes
-    assert diag[L.D_E_TENSION] == pytest.approx(0.5 * 8e6 * (0.01 ** 2 + 0.01 ** 2 + (0.22 - 0.19) ** 2))
+    assert diag[L.D_E_TENSION] == pytest.approx(0.5 * 8e6 * (0.01**2 + 0.01**2 + (0.22 - 0.19) ** 2))
 
 
 def test_wheel_on_link_eq4_and_eq7_split():
     pins = straight_track()
-    w = [0.30, 0.5 + 0.29]          # above link 0 (pins 0.38 -> 0.19), s = 0.29
+    w = [0.30, 0.5 + 0.29]  # above link 0 (pins 0.38 -> 0.19), s = 0.29
     fpin, fwheel, diag, _ = loads(pins, [w])
     p = K * (RHO - 0.29)
     np.testing.assert_allclose(fwheel[0], [0.0, p], atol=1e-6)
-    d0, d1 = 0.38 - 0.30, 0.30 - 0.19   # from pin 0 (front) and from pin 1
+    d0, d1 = 0.38 - 0.30, 0.30 - 0.19  # from pin 0 (front) and from pin 1
     np.testing.assert_allclose(fpin[0], [0.0, -p * d1 / 0.19], atol=1e-6)
     np.testing.assert_allclose(fpin[1], [0.0, -p * d0 / 0.19], atol=1e-6)
     assert np.abs(fpin[2:]).max() < 1e-6
@@ -75,7 +75,7 @@ def test_eq7_preserves_force_and_moment_on_a_slanted_link():
     t = np.subtract(pins[1], pins[0])
     t /= np.linalg.norm(t)
     n = np.array([t[1], -t[0]])
-    u = np.array(pins[0]) + 0.07 * t           # foot of the wheel centre on link 0
+    u = np.array(pins[0]) + 0.07 * t  # foot of the wheel centre on link 0
     w = u + 0.285 * n
     fpin, fwheel, _, _ = loads(pins, [w])
     p = K * (RHO - 0.285)
@@ -106,9 +106,9 @@ def test_wheel_on_pin_wedge_only_when_bend_is_convex_towards_wheel():
 
 def test_wheel_through_track_stops_the_run():
     pins = straight_track()
-    _, _, diag, _ = loads(pins, [[0.30, 0.5 - 0.05]])   # centre 5 cm below the centre line
+    _, _, diag, _ = loads(pins, [[0.30, 0.5 - 0.05]])  # centre 5 cm below the centre line
     assert diag[L.D_STATUS] == WHEEL_THROUGH_TRACK
-    _, _, diag, _ = loads(pins, [[0.30, 0.5 - 0.35]])   # far on the wrong side: no contact
+    _, _, diag, _ = loads(pins, [[0.30, 0.5 - 0.35]])  # far on the wrong side: no contact
     assert diag[L.D_STATUS] == 0
 
 
@@ -122,14 +122,14 @@ def test_pin_on_ground_segment_eq6():
 
 def test_corner_on_link_split_and_corner_through_track():
     step = ((-1000, 0.0), (0.25, 0.0), (0.25, 0.1), (1000, 0.1))
-    pins = [[0.38, 0.115], [0.19, 0.115], [0.0, 0.115]]    # link 0 spans the corner x = 0.25
+    pins = [[0.38, 0.115], [0.19, 0.115], [0.0, 0.115]]  # link 0 spans the corner x = 0.25
     fpin, _, diag, _ = loads(pins, [[5.0, 5.0]], ground=step)
     p = K * (HG - 0.015)
     d0 = 0.38 - 0.25
     np.testing.assert_allclose(fpin[0], [0.0, p * (0.19 - d0) / 0.19], atol=1e-6)
     np.testing.assert_allclose(fpin[1], [0.0, p * d0 / 0.19], atol=1e-6)
     assert diag[L.D_CORNER_FORCE] == pytest.approx(p)
-    pins = [[0.38, 0.095], [0.19, 0.095], [0.0, 0.095]]    # corner 5 mm above the centre line
+    pins = [[0.38, 0.095], [0.19, 0.095], [0.0, 0.095]]  # corner 5 mm above the centre line
     _, _, diag, _ = loads(pins, [[5.0, 5.0]], ground=step)
     assert diag[L.D_STATUS] == CORNER_THROUGH_TRACK
 

@@ -5,10 +5,9 @@ gradient of that energy, and paper_step without damping conserves energy."""
 
 import numpy as np
 import pytest
+from test_contacts import RHO, K, loads
 
-import trackbench as tb
-from trackbench.model import layout as L
-from test_contacts import K, RHO, loads
+from trackbench.model.core import indices as L
 
 STEP = ((-1000, 0.0), (0.0, 0.0), (0.0, 0.1), (1000, 0.1))
 
@@ -65,6 +64,7 @@ def test_wheel_energy_is_continuous_across_a_pin(rise):
     """A wheel centre 4 mm lower than touching the middle pin, slid across it over a dip, a
     straight track and a bump: in the dip the paper's energy jumps where the foot of the
     wheel centre leaves a link that is still compressed; the continuous one never jumps."""
+
     def energy(geometry):
         return lambda x: pad_energy(bent_track(rise), [[x, 0.5 + RHO - 0.004]], geometry=geometry)
 
@@ -72,8 +72,8 @@ def test_wheel_energy_is_continuous_across_a_pin(rise):
     jump, e = largest_jump(energy("continuous"), xs)
     paper_jump, _ = largest_jump(energy("paper"), xs)
     print(f"rise {rise}: largest energy jump paper {paper_jump:.1f} J, continuous {jump:.1e} J")
-    assert e[120] > 0.5 * K * 0.003 ** 2     # in contact over the pin
-    assert jump < 1e-3                       # J
+    assert e[120] > 0.5 * K * 0.003**2  # in contact over the pin
+    assert jump < 1e-3  # J
     if rise > 0:
         assert paper_jump > 100.0
 
@@ -84,8 +84,12 @@ def test_pin_energy_is_continuous_across_a_convex_corner():
     the continuous geometry follows the round cap of the corner."""
     xs = np.linspace(-0.03, 0.03, 121)
     for g, jumps in (("paper", True), ("continuous", False)):
-        jump, _ = largest_jump(lambda x: pad_energy([[x + 0.25, 0.45], [x, 0.117], [x - 0.25, 0.45]], [[5.0, 5.0]],
-                                                    ground=STEP, geometry=g), xs)
+        jump, _ = largest_jump(
+            lambda x: pad_energy(
+                [[x + 0.25, 0.45], [x, 0.117], [x - 0.25, 0.45]], [[5.0, 5.0]], ground=STEP, geometry=g
+            ),
+            xs,
+        )
         print(f"pin over a corner, {g}: largest energy jump {jump:.1e} J")
         assert (jump > 100.0) if jumps else (jump < 1e-3), g
 
@@ -101,7 +105,9 @@ def _configurations(rng):
     for _ in range(40):
         x = rng.uniform(-0.05, 0.05)
         bend = rng.uniform(-0.03, 0.03)
-        pins = np.array([[x + 0.19, 0.115 + bend], [x, 0.115 + rng.uniform(-0.01, 0.0)], [x - 0.19, 0.115 + bend]])
+        pins = np.array(
+            [[x + 0.19, 0.115 + bend], [x, 0.115 + rng.uniform(-0.01, 0.0)], [x - 0.19, 0.115 + bend]]
+        )
         yield pins, np.array([[5.0, 5.0]]), STEP
 
 
@@ -135,9 +141,11 @@ def test_paper_step_conserves_energy(continuous_run):
     assert run.attrs["status"] == "completed"
     e0 = float(run.attrs["initial_total_energy"])
     balance = run.energy_balance_error.values * e0
-    print(f"continuous paper_step: largest jump {np.abs(np.diff(balance)).max():.3f} J, balance "
-          f"{100 * np.abs(run.energy_balance_error.values).max():.2e} %")
-    assert np.abs(np.diff(balance)).max() < 1.0                    # J, between steps
-    assert np.abs(run.energy_balance_error.values).max() < 1e-4    # 0.01 %
+    print(
+        f"continuous paper_step: largest jump {np.abs(np.diff(balance)).max():.3f} J, balance "
+        f"{100 * np.abs(run.energy_balance_error.values).max():.2e} %"
+    )
+    assert np.abs(np.diff(balance)).max() < 1.0  # J, between steps
+    assert np.abs(run.energy_balance_error.values).max() < 1e-4  # 0.01 %
     assert float(run.max_energy_residual) < 1e-6
     assert float(run.first_contact_time) == pytest.approx(0.0568, abs=1e-6)

@@ -66,7 +66,7 @@ def test_paper_step_energy(paper_run):
     assert float(paper_run.max_energy_residual) < 1e-6
     assert np.abs(paper_run.energy_residual.values).max() < 1e-6
     # the paper's energy balance (0.06 %) over the reproducible part of the run; later,
-    # single contact switches of the spec's discontinuous contact model (a loaded wheel
+    # single contact switches of the paper's discontinuous contact model (a loaded wheel
     # entering the two-link overlap at a pin) make jumps of up to ~2 kJ whose size
     # depends on the chaotic state: README, "Accuracy", gives the measured spread.
     early = paper_run.energy_balance_error.sel(time=slice(0, 0.25)).values
@@ -76,7 +76,9 @@ def test_paper_step_energy(paper_run):
 def test_paper_step_peaks_are_seen_between_samples(paper_run):
     # peaks over accepted steps are at least the peaks of the (Hermite-interpolated)
     # output samples, up to the interpolation error
-    assert np.all(paper_run.peak_wheel_force_y.values >= paper_run.wheel_force_y.max("time").values * (1 - 1e-6))
+    assert np.all(
+        paper_run.peak_wheel_force_y.values >= paper_run.wheel_force_y.max("time").values * (1 - 1e-6)
+    )
     assert float(paper_run.peak_chassis_ay) >= float(paper_run.chassis_ay.max()) - 1e-6
     assert float(paper_run.min_chassis_vx) <= float(paper_run.chassis_vx.min()) + 1e-6
 
@@ -92,12 +94,14 @@ def test_convergence_early_quantities(paper_run_short):
     assert abs(y - yt) / yt < 1e-3
     # the first-contact time agrees as well (wheel 2's peak at 0.20 s, after the first
     # link compressions, moves by up to ~0.2 % at this tolerance: see README, Accuracy)
-    assert float(paper_run_short.first_contact_time) == pytest.approx(float(tight.first_contact_time), abs=1e-4)
+    assert float(paper_run_short.first_contact_time) == pytest.approx(
+        float(tight.first_contact_time), abs=1e-4
+    )
 
 
 def test_late_quantities_only_as_ranges(paper_run):
     """After ~0.25 s the motion is chaotic: compare late peaks with a run at another
-    tolerance only as a range (spec: 10-60 % between correct runs)."""
+    tolerance only as a range (10-60 % between correct runs: docs/validation.md)."""
     other = tb.simulate(tb.Scenario.paper(method="dop853", tolerance=1e-9))
     for ds in (paper_run, other):
         late = ds.peak_wheel_force_y.sel(wheel=[3, 4, 5]).values
@@ -110,9 +114,10 @@ def test_late_quantities_only_as_ranges(paper_run):
 def test_neighbour_lists_equal_full_search(paper_run):
     """The contact search skips far pairs; with a skin so large that every pair is a
     candidate the forces are identical."""
-    from trackbench.model import layout as L
-    from trackbench.model.reduced import reduced_rhs
+    from trackbench.model.core import indices as L
+    from trackbench.model.dynamics.reduced import reduced_rhs
     from trackbench.simulate import Model, build_ground
+
     sc = tb.Scenario.paper()
     eq = equilibrium(sc)
     ground, _ = build_ground(sc, eq)
@@ -126,10 +131,12 @@ def test_neighbour_lists_equal_full_search(paper_run):
         off = L.pin_offset(5)
         for i in range(0, ds.sizes["time"], 97):
             y = np.zeros(2 * nq + 1)
-            y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch"))
-            y[L.Q_ARM:L.Q_ARM + 5] = ds.arm_angle.values[i]
+            y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (
+                float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")
+            )
+            y[L.Q_ARM : L.Q_ARM + 5] = ds.arm_angle.values[i]
             y[off:nq:2] = ds.pin_x.values[i, 1:-1]
-            y[off + 1:nq:2] = ds.pin_y.values[i, 1:-1]
+            y[off + 1 : nq : 2] = ds.pin_y.values[i, 1:-1]
             dy = np.zeros_like(y)
             d = np.zeros(L.n_diag(5, 30))
             reduced_rhs(y, m.arrays, m.work, dy, d)
@@ -140,14 +147,22 @@ def test_neighbour_lists_equal_full_search(paper_run):
     np.testing.assert_array_equal(out[0], out[1])
 
 
-@pytest.mark.parametrize("terrain", [
-    {"kind": "block", "height": 0.05, "length": 0.5, "first_contact_time": 0.0568},
-    {"kind": "ramp", "height": 0.2, "length": 1.0, "position": 3.0},
-    {"kind": "sequence", "obstacles": [{"kind": "step", "height": 0.05, "first_contact_time": 0.03},
-                                       {"kind": "bump", "height": 0.05, "length": 0.3, "gap": 0.5}]},
-])
+@pytest.mark.parametrize(
+    "terrain",
+    [
+        {"kind": "block", "height": 0.05, "length": 0.5, "first_contact_time": 0.0568},
+        {"kind": "ramp", "height": 0.2, "length": 1.0, "position": 3.0},
+        {
+            "kind": "sequence",
+            "obstacles": [
+                {"kind": "step", "height": 0.05, "first_contact_time": 0.03},
+                {"kind": "bump", "height": 0.05, "length": 0.3, "gap": 0.5},
+            ],
+        },
+    ],
+)
 def test_other_terrains_run_with_small_residual(terrain):
     ds = tb.simulate(tb.Scenario.from_dict({"terrain": terrain, "duration": 0.3}))
     assert ds.attrs["status"] == "completed", ds.attrs["status_message"]
     assert float(ds.max_energy_residual) < 1e-6
-    assert float(ds.obstacle_force.max()) > 0.0      # the obstacle was reached
+    assert float(ds.obstacle_force.max()) > 0.0  # the obstacle was reached

@@ -9,8 +9,14 @@ import trackbench as tb
 from trackbench.scenario import ScenarioError
 
 DAMPED = {"preset": "damped"}
-PEAKS = ["peak_ground_force_y", "peak_link_tension", "min_link_tension", "peak_chassis_ay", "min_chassis_ay",
-         "min_chassis_vx"]
+PEAKS = [
+    "peak_ground_force_y",
+    "peak_link_tension",
+    "min_link_tension",
+    "peak_chassis_ay",
+    "min_chassis_ay",
+    "min_chassis_vx",
+]
 
 
 @pytest.fixture(scope="module")
@@ -22,7 +28,7 @@ def damped_runs():
 
 
 def test_damped_peaks_are_reproducible(damped_runs):
-    """The spec's chaos is gone: every summary peak within 1 % over tolerances and nudges."""
+    """The paper model's chaos is gone: every summary peak within 1 % over tolerances and nudges."""
     values = {k: [float(ds[k]) for ds in damped_runs] for k in PEAKS}
     for i in range(5):
         values[f"wheel {i + 1}"] = [float(ds.peak_wheel_force_y[i]) for ds in damped_runs]
@@ -34,7 +40,7 @@ def test_damped_peaks_are_reproducible(damped_runs):
 
 def test_damped_energy_closes(damped_runs):
     ds = damped_runs[1]
-    assert float(ds.max_energy_residual) < 1e-6          # dampers' work is in the residual
+    assert float(ds.max_energy_residual) < 1e-6  # dampers' work is in the residual
     dissipated = float(ds.energy_dissipated[-1])
     assert dissipated > 0.0
     # balance + dissipated stays near its start: what the paper's balance loses, the dampers took
@@ -47,8 +53,12 @@ def test_dampers_do_not_act_on_rigid_motion():
     ds = tb.simulate(sc)
     assert ds.attrs["status"] == "completed"
     dx = ds.chassis_x.values - ds.chassis_x.values[0] - 10.0 * ds.time.values
-    moved = [np.abs(dx).max(), np.abs(ds.chassis_y - ds.chassis_y[0]).max(),
-             np.abs(ds.pin_y - ds.pin_y[0]).max(), np.abs(ds.arm_angle - ds.arm_angle[0]).max()]
+    moved = [
+        np.abs(dx).max(),
+        np.abs(ds.chassis_y - ds.chassis_y[0]).max(),
+        np.abs(ds.pin_y - ds.pin_y[0]).max(),
+        np.abs(ds.arm_angle - ds.arm_angle[0]).max(),
+    ]
     assert max(float(v) for v in moved) < 1e-7, moved
     assert float(ds.energy_dissipated[-1]) < 1e-6
 
@@ -67,25 +77,28 @@ def test_restitution_laws_on_the_vehicle(law):
     assert float(a.energy_dissipated[-1]) > 0.0
 
 
-@pytest.mark.parametrize("bad, words", [
-    ({"contact.damping": "viscous"}, "contact.damping_ratio"),
-    ({"contact.damping": "hunt_crossley"}, "contact.restitution"),
-    ({"contact.damping": "flores", "contact.restitution": 1.5}, "contact.restitution"),
-    ({"contact.damping": "flores", "contact.restitution": 0.0}, "contact.restitution"),
-    ({"contact.damping_ratio": -0.1}, "contact.damping_ratio"),
-    ({"track.link_damping": -5.0}, "track.link_damping"),
-    ({"vehicle.arm_damping": [100.0, 0.0]}, "vehicle.arm_damping"),
-    ({"vehicle.arm_damping": [100.0, -1.0, 0.0, 0.0, 0.0]}, "vehicle.arm_damping[1]"),
-    ({"preset": "soft"}, "preset"),
-    ({"preset": "damped", "solver": "lee"}, "solver = 'lee'"),
-    ({"contact.geometry": "smooth"}, "contact.geometry"),
-    ({"contact.geometry": "continuous", "solver": "lee"}, "contact.geometry"),
-    ({"contact.friction": -0.1}, "contact.friction"),
-    ({"contact.friction_velocity": 0.0}, "contact.friction_velocity"),
-    ({"contact.friction": 0.5, "solver": "lee"}, "contact.friction"),
-    ({"contact.friction_law": "stribeck"}, "one of regularised, bristle"),
-    ({"contact.friction_stiffness": 0.0}, "contact.friction_stiffness"),
-])
+@pytest.mark.parametrize(
+    "bad, words",
+    [
+        ({"contact.damping": "viscous"}, "contact.damping_ratio"),
+        ({"contact.damping": "hunt_crossley"}, "contact.restitution"),
+        ({"contact.damping": "flores", "contact.restitution": 1.5}, "contact.restitution"),
+        ({"contact.damping": "flores", "contact.restitution": 0.0}, "contact.restitution"),
+        ({"contact.damping_ratio": -0.1}, "contact.damping_ratio"),
+        ({"track.link_damping": -5.0}, "track.link_damping"),
+        ({"vehicle.arm_damping": [100.0, 0.0]}, "vehicle.arm_damping"),
+        ({"vehicle.arm_damping": [100.0, -1.0, 0.0, 0.0, 0.0]}, "vehicle.arm_damping[1]"),
+        ({"preset": "soft"}, "preset"),
+        ({"preset": "damped", "solver": "lee"}, "solver = 'lee'"),
+        ({"contact.geometry": "smooth"}, "contact.geometry"),
+        ({"contact.geometry": "continuous", "solver": "lee"}, "contact.geometry"),
+        ({"contact.friction": -0.1}, "contact.friction"),
+        ({"contact.friction_velocity": 0.0}, "contact.friction_velocity"),
+        ({"contact.friction": 0.5, "solver": "lee"}, "contact.friction"),
+        ({"contact.friction_law": "stribeck"}, "one of regularised, bristle"),
+        ({"contact.friction_stiffness": 0.0}, "contact.friction_stiffness"),
+    ],
+)
 def test_bad_damping_input_is_one_line(bad, words):
     with pytest.raises(ScenarioError) as e:
         tb.Scenario.from_dict(bad)

@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench.model import layout as L
-from trackbench.model.kinematics import place
-from trackbench.model.reduced import reduced_rhs
+from trackbench.model.contact.gaps import pin_cap_weight
+from trackbench.model.contact.laws import GEOMETRY_CONTINUOUS
+from trackbench.model.core import indices as L
+from trackbench.model.core.bundles import EventWork
+from trackbench.model.dynamics.reduced import reduced_rhs
+from trackbench.model.vehicle.kinematics import place
 from trackbench.simulate import Model, build_ground, equilibrium
-from trackbench.model.contact_laws import GEOMETRY_CONTINUOUS
-from trackbench.model.gaps import pin_cap_weight
-from trackbench.model.bundles import EventWork
-from trackbench.solvers.events import _gap_end
+from trackbench.solvers.common.events import _gap_end
 
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
 
@@ -31,8 +31,9 @@ def _weight(kind, i, b, m, pins, probes, continuous):
     p = probes[kind][i]
     t0 = (pins[b] - pins[b - 1]) / np.linalg.norm(pins[b] - pins[b - 1])
     t1 = (pins[b + 1] - pins[b]) / np.linalg.norm(pins[b + 1] - pins[b])
-    return pin_cap_weight(p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1], kind != L.K_CORNER_PIN,
-                          continuous)
+    return pin_cap_weight(
+        p[0], p[1], pins[b, 0], pins[b, 1], t0[0], t0[1], t1[0], t1[1], kind != L.K_CORNER_PIN, continuous
+    )
 
 
 def _event_energy(m, ev, pins, probes):
@@ -71,15 +72,17 @@ def test_event_contact_decision_equals_the_kernels(geometry, request):
     for i in rng.choice(ds.sizes["time"], 60, replace=False):
         for _ in range(5):
             y = np.zeros(2 * nq + 1)
-            y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch"))
-            y[L.Q_ARM:L.Q_ARM + model.nw] = ds.arm_angle.values[i]
+            y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (
+                float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")
+            )
+            y[L.Q_ARM : L.Q_ARM + model.nw] = ds.arm_angle.values[i]
             y[off:nq:2] = ds.pin_x.values[i, 1:-1]
-            y[off + 1:nq:2] = ds.pin_y.values[i, 1:-1]
-            y[off:nq] += rng.uniform(-0.01, 0.01, nq - off)   # within a pad's depth of every threshold
+            y[off + 1 : nq : 2] = ds.pin_y.values[i, 1:-1]
+            y[off:nq] += rng.uniform(-0.01, 0.01, nq - off)  # within a pad's depth of every threshold
             d = np.zeros(L.n_diag(model.nw, model.n_links))
             reduced_rhs(y, m, w, np.zeros_like(y), d)
             if d[L.D_STATUS] != 0.0:
-                continue   # a wheel or corner through the track: the run would stop here
+                continue  # a wheel or corner through the track: the run would stop here
             place(y[:nq], m.par, m.arms, m.ends, w.apos, w.wc, w.arm)
             ev = EventWork(w.apos, w.apos, w.wc, w.wc, w.arm)
             e = _event_energy(m, ev, w.apos, {L.K_WHEEL_PIN: w.wc, L.K_CORNER_PIN: m.corners})
@@ -94,11 +97,11 @@ def test_closed_event_contact_decision_equals_the_kernels():
     """The closed layout: road wheels, idler, ground and the sprocket's teeth as the event
     location sees them (its scratch placed by loop.place_loop) carry the kernels' pad
     energies, pins moved within a pad's depth of every threshold."""
-    from trackbench.model.bundles import event_arrays
-    from trackbench.model.loop import loop_rhs, place_loop
+    from trackbench.model.core.bundles import event_arrays
+    from trackbench.model.dynamics.closed_track_jit import loop_rhs, place_loop
+    from trackbench.model.vehicle.teeth_jit import tooth_shape
     from trackbench.simulate import initial_state
-    from trackbench.model.sprocket import tooth_shape
-    from trackbench.solvers.events import _teeth_gap
+    from trackbench.solvers.common.events import _teeth_gap
 
     sc = tb.Scenario.from_dict({"track.layout": "closed"})
     eq = equilibrium(sc)
@@ -113,20 +116,26 @@ def test_closed_event_contact_decision_equals_the_kernels():
     checked = {"wheel": 0, "ground": 0, "teeth": 0}
     for _ in range(40):
         y = y0.copy()
-        y[off:off + 2 * n] += rng.uniform(-0.01, 0.01, 2 * n)
+        y[off : off + 2 * n] += rng.uniform(-0.01, 0.01, 2 * n)
         y[i_s] += rng.uniform(-0.05, 0.05)
         d = np.zeros(L.n_diag(model.nw, n))
         loop_rhs(y, m, w, np.zeros_like(y), d)
         if d[L.D_STATUS] != 0.0:
             continue
         place_loop(y[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
-        pins = np.vstack([ev.pins0, ev.pins0[1]])          # pin 1 after pin n_links
-        energy = _event_energy(m, ev, pins, {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0,
-                                             L.K_CORNER_PIN: m.corners})
+        pins = np.vstack([ev.pins0, ev.pins0[1]])  # pin 1 after pin n_links
+        energy = _event_energy(
+            m, ev, pins, {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0, L.K_CORNER_PIN: m.corners}
+        )
         teeth = 0.0
         for b in range(1, n + 1):
-            g = _teeth_gap(ev.pins0[b, 0], ev.pins0[b, 1], (y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH], y[i_s]), m.loop,
-                           tooth_shape(m.loop))
+            g = _teeth_gap(
+                ev.pins0[b, 0],
+                ev.pins0[b, 1],
+                (y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH], y[i_s]),
+                m.loop,
+                tooth_shape(m.loop),
+            )
             teeth += 0.5 * m.loop[L.LP_TOOTH_STIFFNESS] * g * g if g > 0.0 else 0.0
         assert energy["wheel"] + teeth == pytest.approx(d[L.D_E_PAD_WHEEL], rel=1e-9, abs=1e-9)
         assert energy["ground"] == pytest.approx(d[L.D_E_PAD_GROUND], rel=1e-9, abs=1e-9)

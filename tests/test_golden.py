@@ -14,7 +14,6 @@ import sys
 from pathlib import Path
 
 import pytest
-
 from golden.cases import CASES, differences, simulate_case
 
 HERE = Path(__file__).parent
@@ -26,9 +25,11 @@ EXPECTED = json.loads((HERE / "golden" / "hashes.json").read_text())
 OTHER_MACHINES = {
     "haswell": {"OPENBLAS_CORETYPE": "Haswell"},
     "skylakex": {"OPENBLAS_CORETYPE": "SkylakeX", "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL"},
-    "prescott_without_fma": {"OPENBLAS_CORETYPE": "Prescott",
-                             "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-FMA4,-AVX512F",
-                             "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL"},
+    "prescott_without_fma": {
+        "OPENBLAS_CORETYPE": "Prescott",
+        "GLIBC_TUNABLES": "glibc.cpu.hwcaps=-AVX2,-FMA,-FMA4,-AVX512F",
+        "NPY_DISABLE_CPU_FEATURES": "X86_V4 AVX512_ICL",
+    },
 }
 
 
@@ -40,13 +41,23 @@ def test_outputs_bit_for_bit(name, paper_run):
     assert not attrs, f"{name}: attributes changed: " + ", ".join(attrs)
 
 
-@pytest.mark.skipif(sys.platform != "linux" or os.uname().machine != "x86_64",
-                    reason="the kernel names are x86-64 OpenBLAS's and glibc's")
+@pytest.mark.skipif(
+    sys.platform != "linux" or os.uname().machine != "x86_64",
+    reason="the kernel names are x86-64 OpenBLAS's and glibc's",
+)
 @pytest.mark.parametrize("machine", sorted(OTHER_MACHINES))
 def test_same_bits_with_another_cpus_kernels(machine):
-    env = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_CORETYPE", "GLIBC_TUNABLES",
-                                                            "NPY_DISABLE_CPU_FEATURES")}
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("OPENBLAS_CORETYPE", "GLIBC_TUNABLES", "NPY_DISABLE_CPU_FEATURES")
+    }
     env.update(OTHER_MACHINES[machine])
-    run = subprocess.run([sys.executable, str(HERE / "golden" / "cases.py"), "--check"], env=env,
-                         capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [sys.executable, str(HERE / "golden" / "cases.py"), "--check"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, f"{machine} ({OTHER_MACHINES[machine]}):\n{run.stdout}{run.stderr[-2000:]}"

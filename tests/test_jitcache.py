@@ -54,8 +54,8 @@ def test_compile_notice_says_once_when_numba_compiles(capsys):
 
     out = io.StringIO()
     with CompileNotice(out) as notice:
-        assert outer(1.0) == 4.0          # compiles outer, and inner inside it
-        assert outer(2.0) == 6.0          # compiled: no event
+        assert outer(1.0) == 4.0  # compiles outer, and inner inside it
+        assert outer(2.0) == 6.0  # compiled: no event
     assert out.getvalue().count("compiling the model") == 1
     assert notice.seconds > 0.0
     quiet = io.StringIO()

@@ -1,4 +1,4 @@
-"""The "lee" solver (issue 3): absolute coordinates, Lee's accelerated multiplier
+"""The "lee" solver: absolute coordinates, Lee's accelerated multiplier
 iteration, Dormand-Prince RKN6(4) steps; cross-validated against the reduced solver.
 
 Runs are shared through module fixtures; every simulation is as short as its test
@@ -14,12 +14,12 @@ import pytest
 import trackbench as tb
 from trackbench.output import summary_numbers
 from trackbench.simulate import equilibrium
-from trackbench.solvers.lee_iter import accel_matrix
-from trackbench.solvers.rkn_tableau import RKN64, NystromPair
+from trackbench.solvers.lee.lee_iter import accel_matrix
+from trackbench.solvers.lee.rkn_tableau import RKN64, NystromPair
 
-EARLY = 0.25          # s: the reproducible part of paper_step (spec)
+EARLY = 0.25  # s: the reproducible part of paper_step (docs/validation.md)
 # "the range the reduced solver gives over tolerances 1e-8 to 1e-11": sampled 3 per
-# decade. The late quantities are chaotic (spec), so a range drawn from the 4 decade
+# decade. The late quantities are chaotic (docs/validation.md), so a range drawn from the 4 decade
 # points alone is a lottery: any rounding-level change of either solver moves a
 # quantity in or out of it (README, "Cross-validation").
 RED_TOLS = tuple(float(t) for t in np.logspace(-8, -11, 10))
@@ -56,7 +56,7 @@ def reduced_runs(paper_run):
 @pytest.fixture(scope="module")
 def reduced_nudged():
     """Reduced solver at the default tolerance, the free pins nudged by 1e-9 m (seeds 1-4):
-    the spread of correct runs that the spec describes."""
+    the spread of correct runs that docs/validation.md describes."""
     return {s: tb.simulate(tb.Scenario.paper(perturbation=1e-9, seed=s)) for s in (1, 2, 3, 4)}
 
 
@@ -65,8 +65,9 @@ def test_rkn_table_is_validated_and_sixth_order():
     A, b, bp, c, eb, ebp, expo = RKN64.arrays()
     assert RKN64.stages == 6 and expo == pytest.approx(-0.2)
     with pytest.raises(ValueError):
-        NystromPair("bad", 6, 4, RKN64.c, RKN64.a, tuple(x * 1.001 for x in RKN64.b), RKN64.bp, RKN64.eb,
-                    RKN64.ebp)
+        NystromPair(
+            "bad", 6, 4, RKN64.c, RKN64.a, tuple(x * 1.001 for x in RKN64.b), RKN64.bp, RKN64.eb, RKN64.ebp
+        )
 
     # y'' = -y, fixed steps: global error falls like h^6
     def solve(n):
@@ -80,7 +81,7 @@ def test_rkn_table_is_validated_and_sixth_order():
         return abs(y - math.cos(2.0)) + abs(yd + math.sin(2.0))
 
     ratio = solve(20) / solve(40)
-    assert 2 ** 5.5 < ratio < 2 ** 7
+    assert 2**5.5 < ratio < 2**7
 
 
 def _paper_alpha_an(C, n, eps1):
@@ -93,8 +94,8 @@ def _paper_alpha_an(C, n, eps1):
         T = bn * np.eye(m) - Cn
         An, Cn = T @ An, Cn @ T
         eps, w = eps * w, bn * bn / 4.0
-    assert np.allclose(Cn, C1 @ An, rtol=1e-10, atol=1e-300)   # (A6)
-    return 2.0 / (w + eps) * An                                 # alpha_n A_n, Eq. (16)
+    assert np.allclose(Cn, C1 @ An, rtol=1e-10, atol=1e-300)  # (A6)
+    return 2.0 / (w + eps) * An  # alpha_n A_n, Eq. (16)
 
 
 @pytest.mark.parametrize("n", [1, 2, 5])
@@ -181,20 +182,30 @@ def _out_of_range(lee_run, reduced_runs):
 
 # quantities settled before 0.25 s: compared sharply in test_early_events_agree, not as
 # late ranges (the issue: "after 0.25 s, every summary quantity ...")
-EARLY_QUANTITIES = ("first_contact_time", "first_compression_time", "peak_wheel1_force_y_kN", "peak_wheel2_force_y_kN")
+EARLY_QUANTITIES = (
+    "first_contact_time",
+    "first_compression_time",
+    "peak_wheel1_force_y_kN",
+    "peak_wheel2_force_y_kN",
+)
 
 
-@pytest.mark.xfail(strict=False, reason="the issue's late range (reduced solver over tolerances 1e-8..1e-11, "
-                   "widened by half) is narrower than the spread of correct runs: the reduced solver itself "
-                   "leaves it under a 1e-9 m nudge (seed 1: peak link tension 388.2 kN above 385.0); "
-                   "the lee run's peak link tension 386.2 kN is 0.3 % above it (README, test prints figures)")
+@pytest.mark.xfail(
+    strict=False,
+    reason="the issue's late range (reduced solver over tolerances 1e-8..1e-11, "
+    "widened by half) is narrower than the spread of correct runs: the reduced solver itself "
+    "leaves it under a 1e-9 m nudge (seed 1: peak link tension 388.2 kN above 385.0); "
+    "the lee run's peak link tension 386.2 kN is 0.3 % above it (README, test prints figures)",
+)
 def test_late_summary_within_reduced_tolerance_range(lee_run, reduced_runs, reduced_nudged):
     """The issue's criterion: every late summary quantity lies in the reduced solver's
     range over tolerances 1e-8..1e-11, widened by half its width on each side."""
     bad = _out_of_range(lee_run, reduced_runs)
     print("out of the widened reduced range (value, low, high):", bad)
-    print("reduced runs with a 1e-9 m nudge outside it:",
-          {s: _out_of_range(ds, reduced_runs) for s, ds in reduced_nudged.items()})
+    print(
+        "reduced runs with a 1e-9 m nudge outside it:",
+        {s: _out_of_range(ds, reduced_runs) for s, ds in reduced_nudged.items()},
+    )
     assert not bad
 
 
@@ -219,13 +230,20 @@ def test_energy(lee_run, paper_run):
         assert np.abs(ds.energy_balance_error.sel(time=slice(0, EARLY)).values).max() < 6e-4
 
 
-@pytest.mark.xfail(strict=False, reason="whole-run max energy-balance deviation: set by a few contact switches "
-                   "of the spec's discontinuous contact model after 0.25 s (jumps up to ~2 kJ) whose size depends on "
-                   "the chaotic state; 0.011-0.22 % over 12 runs at tolerances 1e-6..1e-11, 5 below 0.06 % (README); the work-based "
-                   "residual shows no integration error")
+@pytest.mark.xfail(
+    strict=False,
+    reason="whole-run max energy-balance deviation: set by a few contact switches "
+    "of the paper's discontinuous contact model after 0.25 s (jumps up to ~2 kJ) whose size depends on "
+    "the chaotic state; 0.011-0.22 % over 12 runs at tolerances 1e-6..1e-11, 5 below 0.06 % (README); the "
+    "work-based residual shows no integration error",
+)
 def test_energy_bar_whole_run(lee_run, paper_run):
-    print("max energy-balance deviation: lee", float(lee_run.max_energy_balance_error),
-          "reduced", float(paper_run.max_energy_balance_error))
+    print(
+        "max energy-balance deviation: lee",
+        float(lee_run.max_energy_balance_error),
+        "reduced",
+        float(paper_run.max_energy_balance_error),
+    )
     assert float(paper_run.max_energy_balance_error) < 6e-4
     assert float(lee_run.max_energy_balance_error) < 6e-4
 

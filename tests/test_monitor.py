@@ -4,7 +4,7 @@ contact switch alone."""
 
 import numpy as np
 
-from trackbench.solvers.monitor import _up
+from trackbench.solvers.common.monitor import _up
 
 
 def _track(times, values, t_switch=-1.0):
@@ -16,15 +16,15 @@ def _track(times, values, t_switch=-1.0):
 
 
 def _bump(t):
-    return np.cos(7.0 * (t - 0.4111))        # peak 1 at t = 0.4111
+    return np.cos(7.0 * (t - 0.4111))  # peak 1 at t = 0.4111
 
 
 def test_smooth_peak_is_refined_between_samples():
     t = np.arange(0.0, 1.0, 0.03)
     f = _bump(t)
     peak, when = _track(t, f)
-    assert 1.0 - f.max() > 1e-3               # the samples miss the peak ...
-    assert abs(peak - 1.0) < 1e-4             # ... the parabola finds it
+    assert 1.0 - f.max() > 1e-3  # the samples miss the peak ...
+    assert abs(peak - 1.0) < 1e-4  # ... the parabola finds it
     assert abs(when - 0.4111) < 2e-3
 
 
@@ -43,9 +43,9 @@ def test_kink_at_a_located_switch_is_not_overshot():
     # the event location ends a step just after the switch; the next step is long again
     t = np.array([0.40, 0.47, 0.5, 0.56, 0.62])
     unflagged, _ = _track(t, kink(t))
-    assert unflagged > 0.5 + 5e-4             # a parabola through a kink overshoots ...
+    assert unflagged > 0.5 + 5e-4  # a parabola through a kink overshoots ...
     peak, when = _track(t, kink(t), t_switch=0.5)
-    assert peak == 0.5 and when == 0.5        # ... so the switch sample is kept as it is
+    assert peak == 0.5 and when == 0.5  # ... so the switch sample is kept as it is
 
 
 def test_no_parabola_across_steps_after_a_rejection():
@@ -59,7 +59,7 @@ def test_no_parabola_across_steps_after_a_rejection():
 
 def test_running_maximum_without_interior_peak():
     t = np.linspace(0.0, 1.0, 11)
-    peak, when = _track(t, t ** 2)
+    peak, when = _track(t, t**2)
     assert peak == 1.0 and when == 1.0
 
 
@@ -67,8 +67,9 @@ def test_running_maximum_without_interior_peak():
 def _update_all(times, values, switch_times, row="wheel"):
     """Feed update_peaks with `values` in one quantity (wheel 1's force, or the chassis
     forward speed for its minimum); returns (peak, time) of that row."""
-    from trackbench.model import layout as L
-    from trackbench.solvers.monitor import init_peaks, update_peaks
+    from trackbench.model.core import indices as L
+    from trackbench.solvers.common.monitor import init_peaks, update_peaks
+
     nw = 5
     peaks = np.zeros((L.n_peaks(nw), 6))
     diag = np.zeros(L.n_diag(nw, 30))
@@ -94,6 +95,6 @@ def test_consecutive_switches_keep_the_kink():
 
 def test_minimum_is_refined_like_a_maximum():
     t = np.arange(0.0, 1.0, 0.03)
-    low, when = _update_all(t, 9.0 - _bump(t), set(), row="vx")   # minimum 8 at t = 0.4111
+    low, when = _update_all(t, 9.0 - _bump(t), set(), row="vx")  # minimum 8 at t = 0.4111
     assert abs(low - 8.0) < 1e-4 < (9.0 - _bump(t)).min() - 8.0
     assert abs(when - 0.4111) < 2e-3

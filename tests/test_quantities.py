@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 from trackbench import output, quantities
-from trackbench.replay.plots import study_axes
 from trackbench.quantities import run_summary
+from trackbench.replay.plots import study_axes
 
 SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1"}
 
@@ -32,8 +32,12 @@ def _check_table(ds, table):
 
 def test_the_closed_track_quantities_match_its_dataset():
     import trackbench as tb
-    ds = tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "duration": 2e-3, "speed": 0.0,
-                                            "terrain": {"kind": "flat"}}))
+
+    ds = tb.simulate(
+        tb.Scenario.from_dict(
+            {"track.layout": "closed", "duration": 2e-3, "speed": 0.0, "terrain": {"kind": "flat"}}
+        )
+    )
     _check_table(ds, [q for q in quantities.TABLE if q.needs != "soil"])
     cols = [c for q, c, _, _ in quantities.entries(ds)]
     assert "peak_sprocket_torque" in cols and "peak_idler_force" in cols
@@ -44,10 +48,19 @@ def test_the_closed_track_quantities_match_its_dataset():
 def test_the_soil_quantities_match_their_dataset():
     """Deepest sinkage (the soil's memory: every accepted step), drawbar pull and slip means
     over the run's second half, in the summary of a driven closed track on soil."""
-    import numpy as np
     import trackbench as tb
-    ds = tb.simulate(tb.Scenario.from_dict({"track.layout": "closed", "terrain": {"kind": "flat", "soil": "lete_sand"},
-                                            "drive.kind": "speed", "speed": 4.0, "duration": 0.05}))
+
+    ds = tb.simulate(
+        tb.Scenario.from_dict(
+            {
+                "track.layout": "closed",
+                "terrain": {"kind": "flat", "soil": "lete_sand"},
+                "drive.kind": "speed",
+                "speed": 4.0,
+                "duration": 0.05,
+            }
+        )
+    )
     _check_table(ds, quantities.TABLE)
     v = quantities.values(ds)
     assert v["peak_sinkage"] >= float(ds.sinkage.max()) > 0.0
@@ -63,12 +76,28 @@ def test_the_soil_quantities_match_their_dataset():
 def test_summary_columns_in_the_documented_order():
     wheels = [c for w in (1, 2) for c in (f"peak_wheel{w}_force_y", f"peak_wheel{w}_force_y_time")]
     assert quantities.summary_columns(2) == wheels + [
-        "peak_ground_force_y", "peak_ground_force_y_time", "peak_link_tension", "peak_link_tension_time",
-        "peak_chassis_ay", "peak_chassis_ay_time", "min_chassis_ay", "min_chassis_ay_time",
-        "min_chassis_vx", "min_chassis_vx_time", "first_contact_time", "first_compression_time",
-        "max_energy_balance_error", "max_energy_residual"]
-    assert quantities.peak_columns(2) == wheels[0::2] + ["peak_ground_force_y", "peak_link_tension",
-                                                         "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx"]
+        "peak_ground_force_y",
+        "peak_ground_force_y_time",
+        "peak_link_tension",
+        "peak_link_tension_time",
+        "peak_chassis_ay",
+        "peak_chassis_ay_time",
+        "min_chassis_ay",
+        "min_chassis_ay_time",
+        "min_chassis_vx",
+        "min_chassis_vx_time",
+        "first_contact_time",
+        "first_compression_time",
+        "max_energy_balance_error",
+        "max_energy_residual",
+    ]
+    assert quantities.peak_columns(2) == wheels[0::2] + [
+        "peak_ground_force_y",
+        "peak_link_tension",
+        "peak_chassis_ay",
+        "min_chassis_ay",
+        "min_chassis_vx",
+    ]
 
 
 def test_run_json_screen_summary_and_table_agree(paper_run_short):
@@ -78,7 +107,10 @@ def test_run_json_screen_summary_and_table_agree(paper_run_short):
     assert v["peak_wheel3_force_y"] == float(paper_run_short.peak_wheel_force_y.sel(wheel=3))
     assert v["min_chassis_vx_time"] == float(paper_run_short.min_chassis_vx_time)
     s = output.summary_numbers(paper_run_short)
-    assert s["peak_link_tension_kN"] == v["peak_link_tension"] / 1e3 and s["peak_chassis_ay"] == v["peak_chassis_ay"]
+    assert (
+        s["peak_link_tension_kN"] == v["peak_link_tension"] / 1e3
+        and s["peak_chassis_ay"] == v["peak_chassis_ay"]
+    )
     assert "min_link_tension" not in v and "min_link_tension_kN" not in s  # in the Dataset, not the summary
     for c in v:
         q, wheel = quantities.quantity_of(c)
@@ -86,6 +118,12 @@ def test_run_json_screen_summary_and_table_agree(paper_run_short):
 
 
 def test_a_placement_parameter_ending_in_time_is_a_study_axis():
-    df = pd.DataFrame({"terrain.first_contact_time": [0.05, 0.06], "peak_wheel12_force_y": [1.0, 2.0],
-                       "max_energy_residual": [1e-9, 2e-9], "peak_link_tension_time": [0.1, 0.2]})
+    df = pd.DataFrame(
+        {
+            "terrain.first_contact_time": [0.05, 0.06],
+            "peak_wheel12_force_y": [1.0, 2.0],
+            "max_energy_residual": [1e-9, 2e-9],
+            "peak_link_tension_time": [0.1, 0.2],
+        }
+    )
     assert study_axes(df) == ["terrain.first_contact_time"]

@@ -13,8 +13,8 @@ import numpy as np
 import trackbench as tb
 if sys.argv[1] == "rhs-first":   # load the right-hand side on its own before the time loop
     from trackbench.simulate import Model, build_ground, equilibrium, initial_state
-    from trackbench.model.reduced import reduced_rhs
-    from trackbench.model import layout as L
+    from trackbench.model.dynamics.reduced import reduced_rhs
+    from trackbench.model.core import indices as L
     sc = tb.Scenario.paper()
     eq = equilibrium(sc)
     m = Model(sc, eq, build_ground(sc, eq)[0])
@@ -27,12 +27,14 @@ print(ds.attrs["steps"], hashlib.sha1(ds.chassis_y.values.tobytes()).hexdigest()
 
 def _run(cache, mode):
     env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
-    out = subprocess.run([sys.executable, "-c", CODE, mode], env=env, capture_output=True, text=True, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", CODE, mode], env=env, capture_output=True, text=True, check=True
+    )
     return out.stdout.split()
 
 
 def test_same_numbers_compiled_or_cached(tmp_path):
-    cold = _run(tmp_path, "plain")          # empty cache: everything compiled here
-    warm = _run(tmp_path, "plain")          # everything loaded from the cache
-    other = _run(tmp_path, "rhs-first")     # loaded in another order
+    cold = _run(tmp_path, "plain")  # empty cache: everything compiled here
+    warm = _run(tmp_path, "plain")  # everything loaded from the cache
+    other = _run(tmp_path, "rhs-first")  # loaded in another order
     assert cold == warm == other

@@ -24,9 +24,20 @@ def test_unknown_names_list_close_matches():
     assert "track.link_length" in error_of(track={"link_lenght": 0.2})
 
 
-@pytest.mark.parametrize("name", ["vehicle.chassis_mass", "vehicle.arm_inertia", "track.pin_mass",
-                                  "track.link_stiffness", "track.wheel_stiffness", "track.link_length",
-                                  "vehicle.wheel_radius", "duration", "output_interval"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "vehicle.chassis_mass",
+        "vehicle.arm_inertia",
+        "track.pin_mass",
+        "track.link_stiffness",
+        "track.wheel_stiffness",
+        "track.link_length",
+        "vehicle.wheel_radius",
+        "duration",
+        "output_interval",
+    ],
+)
 @pytest.mark.parametrize("value", [0.0, -1.0, math.nan])
 def test_non_positive_or_nan_values(name, value):
     msg = error_of(**{name: value})
@@ -57,19 +68,46 @@ def test_valid_overrides_resolve():
 
 
 def test_cli_bad_input_is_one_line_and_nothing_written(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "trackbench.cli", "run", "--set", "vehicle.chassis_mas=1",
-                        "--out", str(tmp_path / "o")], capture_output=True, text=True)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "trackbench.cli",
+            "run",
+            "--set",
+            "vehicle.chassis_mas=1",
+            "--out",
+            str(tmp_path / "o"),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0 and "vehicle.chassis_mass" in r.stderr
     assert not (tmp_path / "o").exists()
 
 
 def test_cli_run_writes_netcdf(tmp_path):
-    r = subprocess.run([sys.executable, "-m", "trackbench.cli", "run", "--set", "speed=12", "--duration", "0.07",
-                        "--out", str(tmp_path)], capture_output=True, text=True)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "trackbench.cli",
+            "run",
+            "--set",
+            "speed=12",
+            "--duration",
+            "0.07",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0, r.stderr
     assert "wheel 1" in r.stdout and "energy balance" in r.stdout
     import xarray as xr
+
     ds = xr.load_dataset(tmp_path / "paper_step.nc")
     assert ds.attrs["status"] == "completed"
     assert float(ds.chassis_vx[0]) == 12.0

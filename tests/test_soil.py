@@ -8,12 +8,19 @@ import sys
 import numpy as np
 import pytest
 
-from trackbench.model.soil import (SOIL_KEYS, SOILS, bekker_pressure, janosi_shear, resolve_soil,
-                                   static_sinkage, wong_thrust)
+from trackbench.model.ground.soil import (
+    SOIL_KEYS,
+    SOILS,
+    bekker_pressure,
+    janosi_shear,
+    resolve_soil,
+    static_sinkage,
+    wong_thrust,
+)
 
 PRESETS = ("dry_sand", "lete_sand", "clayey_soil", "heavy_clay", "sandy_loam")
 
-# Wong's table (spec) in SI: n, k_c N/m^(n+1), k_phi N/m^(n+2), c Pa, phi deg
+# Wong's table (docs/model.md) in SI: n, k_c N/m^(n+1), k_phi N/m^(n+2), c Pa, phi deg
 WONG_SI = {
     "dry_sand": (1.1, 990.0, 1.52843e6, 1040.0, 28.0),
     "lete_sand": (0.79, 1.02e5, 5.301e6, 1300.0, 31.1),
@@ -36,6 +43,7 @@ def table(**changes):
 
 # ---- presets ----
 
+
 def test_presets_are_the_five_of_the_spec():
     assert tuple(SOILS) == PRESETS
     assert all(tuple(SOILS[name]) == SOIL_KEYS for name in PRESETS)
@@ -46,9 +54,9 @@ def test_preset_resolves_in_si_with_positive_moduli(name):
     soil = resolve_soil(name)
     assert (soil["n"], soil["k_c"], soil["k_phi"], soil["cohesion"], soil["friction_angle"]) == WONG_SI[name]
     assert soil["k_phi"] > 0 and soil["k_c"] >= 0 and soil["cohesion"] >= 0
-    assert 0.005 <= soil["shear_modulus"] <= 0.025          # Wong: 0.6 cm (clay) .. 2.5 cm (loose sand)
-    assert soil["unloading_stiffness"] >= 1e8               # Pa/m, Chrono SCM values
-    assert resolve_soil(dict(soil)) == soil                  # a preset passes the table check
+    assert 0.005 <= soil["shear_modulus"] <= 0.025  # Wong: 0.6 cm (clay) .. 2.5 cm (loose sand)
+    assert soil["unloading_stiffness"] >= 1e8  # Pa/m, Chrono SCM values
+    assert resolve_soil(dict(soil)) == soil  # a preset passes the table check
 
 
 def test_lete_sand_in_si():
@@ -68,8 +76,17 @@ def test_rigid_is_none():
 
 
 def test_table_resolves_to_floats():
-    soil = resolve_soil({"n": 1, "k_c": 0, "k_phi": 2_000_000, "cohesion": 0, "friction_angle": 0,
-                         "shear_modulus": 0.01, "unloading_stiffness": 200_000_000})
+    soil = resolve_soil(
+        {
+            "n": 1,
+            "k_c": 0,
+            "k_phi": 2_000_000,
+            "cohesion": 0,
+            "friction_angle": 0,
+            "shear_modulus": 0.01,
+            "unloading_stiffness": 200_000_000,
+        }
+    )
     assert all(type(v) is float for v in soil.values())
     assert tuple(soil) == SOIL_KEYS
 
@@ -80,11 +97,12 @@ def test_table_accepts_the_closed_bounds():
 
 
 def test_module_does_not_load_numba():
-    code = "import sys, trackbench.model.soil; assert 'numba' not in sys.modules"
+    code = "import sys, trackbench.model.ground.soil; assert 'numba' not in sys.modules"
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
 # ---- bad input: ValueError, one line, naming the culprit ----
+
 
 def raises(value, *culprits):
     with pytest.raises(ValueError) as info:
@@ -97,12 +115,16 @@ def raises(value, *culprits):
 
 
 def test_misspelt_preset_suggests_the_closest():
-    msg = raises("lete_snd", "terrain.soil", "'lete_snd'", "did you mean lete_sand", "allowed: rigid, dry_sand")
+    msg = raises(
+        "lete_snd", "terrain.soil", "'lete_snd'", "did you mean lete_sand", "allowed: rigid, dry_sand"
+    )
     assert msg.startswith("terrain.soil = 'lete_snd' is not a soil")
 
 
 def test_unknown_preset_lists_the_allowed():
-    raises("granite", "'granite'", "rigid", "dry_sand", "lete_sand", "clayey_soil", "heavy_clay", "sandy_loam")
+    raises(
+        "granite", "'granite'", "rigid", "dry_sand", "lete_sand", "clayey_soil", "heavy_clay", "sandy_loam"
+    )
 
 
 @pytest.mark.parametrize("value", [42, None, 1.5, ["dry_sand"], ("rigid",)])
@@ -133,19 +155,31 @@ def test_non_numbers(key, bad):
     raises(t, f"terrain.soil.{key}")
 
 
-@pytest.mark.parametrize("key,bad", [
-    ("k_phi", 0.0), ("k_phi", -1e6),
-    ("shear_modulus", 0.0), ("shear_modulus", -0.01),
-    ("unloading_stiffness", 0.0), ("unloading_stiffness", -2e8),
-    ("k_c", -1.0), ("cohesion", -1.0),
-    ("friction_angle", -1.0), ("friction_angle", 60.0), ("friction_angle", 75.0),
-    ("n", 0.0), ("n", -0.5), ("n", 2.5),
-])
+@pytest.mark.parametrize(
+    "key,bad",
+    [
+        ("k_phi", 0.0),
+        ("k_phi", -1e6),
+        ("shear_modulus", 0.0),
+        ("shear_modulus", -0.01),
+        ("unloading_stiffness", 0.0),
+        ("unloading_stiffness", -2e8),
+        ("k_c", -1.0),
+        ("cohesion", -1.0),
+        ("friction_angle", -1.0),
+        ("friction_angle", 60.0),
+        ("friction_angle", 75.0),
+        ("n", 0.0),
+        ("n", -0.5),
+        ("n", 2.5),
+    ],
+)
 def test_out_of_range(key, bad):
     raises(table(**{key: bad}), f"terrain.soil.{key} = {bad!r}", "expected")
 
 
 # ---- Bekker pressure-sinkage ----
+
 
 @pytest.mark.parametrize("name", PRESETS)
 def test_static_sinkage_inverts_bekker_pressure(name):
@@ -155,13 +189,15 @@ def test_static_sinkage_inverts_bekker_pressure(name):
         z = static_sinkage(p, soil, b)
         assert np.all(z > 0)
         np.testing.assert_allclose(bekker_pressure(z, soil, b), p, rtol=1e-12, atol=0)
-        np.testing.assert_allclose(static_sinkage(bekker_pressure(z, soil, b), soil, b), z, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(
+            static_sinkage(bekker_pressure(z, soil, b), soil, b), z, rtol=1e-12, atol=0
+        )
 
 
 def test_bekker_pressure_by_hand():
     soil = resolve_soil("sandy_loam")
     # (74.6e3 / 0.5 + 2080e3) * 0.04^1.1
-    assert bekker_pressure(0.04, soil, 0.5) == pytest.approx((149.2e3 + 2080e3) * 0.04 ** 1.1, rel=1e-14)
+    assert bekker_pressure(0.04, soil, 0.5) == pytest.approx((149.2e3 + 2080e3) * 0.04**1.1, rel=1e-14)
     assert isinstance(bekker_pressure(0.04, soil, 0.5), float)
 
 
@@ -181,6 +217,7 @@ def test_track_width():
 
 # ---- Janosi-Hanamoto shear ----
 
+
 def test_janosi_limits():
     soil = resolve_soil("clayey_soil")
     p = 4e4
@@ -197,14 +234,25 @@ def test_janosi_is_odd_in_j_and_ignores_tension():
     j = np.array([0.001, 0.01, 0.1])
     np.testing.assert_array_equal(janosi_shear(2e4, -j, soil), -janosi_shear(2e4, j, soil))
     np.testing.assert_array_equal(janosi_shear(-2e4, j, soil), janosi_shear(0.0, j, soil))
-    assert janosi_shear(0.0, 10.0, soil) == pytest.approx(1040.0, rel=1e-14)   # cohesion alone
+    assert janosi_shear(0.0, 10.0, soil) == pytest.approx(1040.0, rel=1e-14)  # cohesion alone
 
 
 # ---- Wong's tractive effort of a track ----
 
+
 def simple_soil(**kw):
-    return resolve_soil({"n": 1.0, "k_c": 0.0, "k_phi": 1e6, "cohesion": 1000.0, "friction_angle": 45.0,
-                         "shear_modulus": 0.05, "unloading_stiffness": 2e8, **kw})
+    return resolve_soil(
+        {
+            "n": 1.0,
+            "k_c": 0.0,
+            "k_phi": 1e6,
+            "cohesion": 1000.0,
+            "friction_angle": 45.0,
+            "shear_modulus": 0.05,
+            "unloading_stiffness": 2e8,
+            **kw,
+        }
+    )
 
 
 def test_wong_thrust_by_hand():
@@ -221,7 +269,7 @@ def test_wong_thrust_tends_to_the_shear_strength():
         x = slip * length / 0.012
         f = wong_thrust(area, weight, length, slip, soil)
         assert f < strength
-        assert 1 - f / strength == pytest.approx(1 / x, rel=1e-9)     # 1 - F/F_max -> K / (i l)
+        assert 1 - f / strength == pytest.approx(1 / x, rel=1e-9)  # 1 - F/F_max -> K / (i l)
     big = simple_soil(shear_modulus=1e-9)
     assert wong_thrust(1.0, 1e4, 2.0, 1.0, big) == pytest.approx(11000.0, rel=1e-8)
 
@@ -233,15 +281,15 @@ def test_wong_thrust_tends_to_zero_with_slip():
     assert f[0] == 0.0
     # small slip, x = i l / K: F ~ F_max (x/2 - x^2/6)
     x = slip[1:] * 2.0 / 0.05
-    np.testing.assert_allclose(f[1:], 11000.0 * (x / 2 - x ** 2 / 6), rtol=1e-5)
+    np.testing.assert_allclose(f[1:], 11000.0 * (x / 2 - x**2 / 6), rtol=1e-5)
     assert np.all(np.diff(f) > 0)
 
 
 def test_wong_thrust_accurate_across_the_series_switch():
-    soil = simple_soil()   # x = slip * 2 / 0.05 = 40 slip
+    soil = simple_soil()  # x = slip * 2 / 0.05 = 40 slip
     x = np.geomspace(1e-10, 1.0, 201)
     f = wong_thrust(1.0, 1e4, 2.0, x / 40.0, soil)
-    exact = [math.fsum((-1) ** (k + 1) * xi ** k / math.factorial(k + 1) for k in range(1, 40)) for xi in x]
+    exact = [math.fsum((-1) ** (k + 1) * xi**k / math.factorial(k + 1) for k in range(1, 40)) for xi in x]
     np.testing.assert_allclose(f, 11000.0 * np.array(exact), rtol=1e-11, atol=0)
 
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench.model.soil import SOILS, bekker_pressure, static_sinkage
+from trackbench.model.ground.soil import SOILS, bekker_pressure, static_sinkage
 from trackbench.scenario import ScenarioError
 
 S = importlib.import_module("trackbench.simulate")
@@ -20,16 +20,26 @@ def test_vehicle_at_rest_stands_on_bekker_pressures(name):
     implementation from the kernel's) carry the weight to 1e-9."""
     # a 1 m wide track: the paper's vehicle sinks 0.3 mm (LETE sand) to 5 cm (dry sand); on
     # heavy clay (n = 0.11) a 0.5 m track would sink ~0.5 m (test_too_soft_soil_says_so)
-    sc = tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": name}, "speed": 0.0, "duration": 1e-3,
-                                "output_interval": 1e-3, "track.width": 1.0})
+    sc = tb.Scenario.from_dict(
+        {
+            "terrain": {"kind": "flat", "soil": name},
+            "speed": 0.0,
+            "duration": 1e-3,
+            "output_interval": 1e-3,
+            "track.width": 1.0,
+        }
+    )
     ds = tb.simulate(sc)
     b, l0 = sc["track.width"], sc["track.link_length"]
     z = ds.sinkage.values[0]
-    assert z.max() > 1e-3          # beyond soil_force.SURFACE_DEPTH: Bekker's curve itself
-    from trackbench.model.soil_force import SURFACE_DEPTH
+    assert z.max() > 1e-3  # beyond soil_force.SURFACE_DEPTH: Bekker's curve itself
+    from trackbench.model.ground.soil_jit import SURFACE_DEPTH
+
     soil = SOILS[name]
     shallow = (z > 0) & (z < SURFACE_DEPTH) & (soil["n"] < 1.0)
-    p = np.where(shallow, bekker_pressure(SURFACE_DEPTH, soil, b) * z / SURFACE_DEPTH, bekker_pressure(z, soil, b))
+    p = np.where(
+        shallow, bekker_pressure(SURFACE_DEPTH, soil, b) * z / SURFACE_DEPTH, bekker_pressure(z, soil, b)
+    )
     assert p.sum() * b * l0 == pytest.approx(ds.attrs["weight"], rel=1e-9)
     deep = z > 1e-3
     p = bekker_pressure(z[deep], SOILS[name], b)
@@ -43,8 +53,11 @@ def test_equilibrium_on_every_soil_at_the_default_width(name, layout):
     """The paper's vehicle and the closed track stand on every preset with the default
     0.5 m track (Newton's method reaches Bekker's n by continuation from n = 1: without it
     clayey soil's equilibrium stalled at 3.7 kN)."""
-    eq = S.equilibrium(tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": name}, "speed": 0.0,
-                                              "track.layout": layout}))
+    eq = S.equilibrium(
+        tb.Scenario.from_dict(
+            {"terrain": {"kind": "flat", "soil": name}, "speed": 0.0, "track.layout": layout}
+        )
+    )
     assert eq.residual < 1e-9 * eq.weight
     assert eq.ground_force == pytest.approx(eq.weight, rel=1e-9)
 
@@ -53,16 +66,27 @@ def test_too_soft_soil_says_so():
     """Heavy clay (n = 0.11) under the paper's vehicle on a 0.5 m track: no equilibrium within
     the vehicle's reach, and the error says how deep the soil would let it sink."""
     from trackbench.status import EquilibriumError
+
     with pytest.raises(EquilibriumError) as e:
-        S.equilibrium(tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": "heavy_clay"}, "speed": 0.0}))
+        S.equilibrium(
+            tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": "heavy_clay"}, "speed": 0.0})
+        )
     assert "check the soil" in str(e.value) and "track.width" in str(e.value) and "\n" not in str(e.value)
 
 
 @pytest.fixture(scope="module")
 def driven_on_sand():
-    sc = tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": "lete_sand"}, "track.layout": "closed",
-                                "preset": "damped", "drive.kind": "speed", "speed": 6.0, "duration": 0.75,
-                                "output_interval": 1e-3})
+    sc = tb.Scenario.from_dict(
+        {
+            "terrain": {"kind": "flat", "soil": "lete_sand"},
+            "track.layout": "closed",
+            "preset": "damped",
+            "drive.kind": "speed",
+            "speed": 6.0,
+            "duration": 0.75,
+            "output_interval": 1e-3,
+        }
+    )
     return sc, tb.simulate(sc)
 
 
@@ -86,6 +110,7 @@ def test_driven_on_sand_outputs_and_energy(driven_on_sand):
     # the work the soil takes counts as dissipated: the paper's balance with it, the tensioner's
     # spring and the drive's work closes to the integration's accuracy
     from trackbench.quantities import accounted_balance
+
     assert float(ds.energy_dissipated[-1]) > 0.0
     assert np.abs(accounted_balance(ds)[0]).max() < 1e-6
     assert np.array_equal(ds.drawbar_pull.values, ds.ground_force_x.values)
@@ -97,13 +122,36 @@ def test_rigid_ground_has_no_soil_outputs():
     assert "sinkage" not in ds and "rut_depth" not in ds
 
 
-@pytest.mark.parametrize("soil, words", [
-    ("lete_snd", "did you mean lete_sand"),
-    ({"n": 0.8, "k_c": 1e5, "k_phi": -1.0, "cohesion": 1e3, "friction_angle": 30.0, "shear_modulus": 0.01,
-      "unloading_stiffness": 2e8}, "k_phi"),
-    ({"n": 2.5, "k_c": 1e5, "k_phi": 5e6, "cohesion": 1e3, "friction_angle": 30.0, "shear_modulus": 0.01,
-      "unloading_stiffness": 2e8}, "terrain.soil.n"),
-])
+@pytest.mark.parametrize(
+    "soil, words",
+    [
+        ("lete_snd", "did you mean lete_sand"),
+        (
+            {
+                "n": 0.8,
+                "k_c": 1e5,
+                "k_phi": -1.0,
+                "cohesion": 1e3,
+                "friction_angle": 30.0,
+                "shear_modulus": 0.01,
+                "unloading_stiffness": 2e8,
+            },
+            "k_phi",
+        ),
+        (
+            {
+                "n": 2.5,
+                "k_c": 1e5,
+                "k_phi": 5e6,
+                "cohesion": 1e3,
+                "friction_angle": 30.0,
+                "shear_modulus": 0.01,
+                "unloading_stiffness": 2e8,
+            },
+            "terrain.soil.n",
+        ),
+    ],
+)
 def test_bad_soil(soil, words):
     with pytest.raises(ScenarioError) as e:
         tb.Scenario.from_dict({"terrain": {"kind": "flat", "soil": soil}})
@@ -123,8 +171,12 @@ def test_soil_on_any_terrain_shape():
 def test_bristle_friction_leaves_the_soil_shear_alone():
     """On soft soil Janosi-Hanamoto's shear replaces friction: the bristle law changes
     nothing there (its anchors would be the soil's touchdown points)."""
-    base = {"terrain": {"kind": "flat", "soil": "lete_sand"}, "contact.friction": 0.6, "duration": 0.02,
-            "output_interval": 1e-3}
+    base = {
+        "terrain": {"kind": "flat", "soil": "lete_sand"},
+        "contact.friction": 0.6,
+        "duration": 0.02,
+        "output_interval": 1e-3,
+    }
     a = tb.simulate(tb.Scenario.paper(**base))
     b = tb.simulate(tb.Scenario.paper(**base, **{"contact.friction_law": "bristle"}))
     np.testing.assert_array_equal(a.ground_force_x.values, b.ground_force_x.values)

@@ -22,7 +22,9 @@ REPO = Path(__file__).resolve().parents[1]
 def files(paper_run, tmp_path_factory):
     """paper_step written by xarray itself (the writer before trackbench.storage), full and compact."""
     d = tmp_path_factory.mktemp("storage")
-    paper_run.to_netcdf(d / "xarray.nc", engine="netcdf4", encoding={k: {"_FillValue": None} for k in paper_run.coords})
+    paper_run.to_netcdf(
+        d / "xarray.nc", engine="netcdf4", encoding={k: {"_FillValue": None} for k in paper_run.coords}
+    )
     write_netcdf(paper_run, d / "full.nc")
     write_netcdf(paper_run, d / "compact.nc", storage="compact")
     return d
@@ -58,7 +60,7 @@ def test_compact_is_smaller_and_within_the_resolution_results_schema_states(file
     for k in full.data_vars:
         a, b = full[k].values, compact[k].values
         if not storage.is_history(k, full[k]):
-            assert np.array_equal(a, b, equal_nan=True), k          # peaks and their times: as computed
+            assert np.array_equal(a, b, equal_nan=True), k  # peaks and their times: as computed
             continue
         kind, bound = bounds.get(k, bounds["*"])
         err = np.abs(b - a)
@@ -73,8 +75,10 @@ def test_compact_is_smaller_and_within_the_resolution_results_schema_states(file
 
 def test_compact_positions_too_wide_for_int32_are_kept_exactly(tmp_path):
     x = np.array([[0.0, 1.0], [300.0, np.nan]])
-    ds = xr.Dataset({"pin_x": (("time", "pin"), x, {"units": "m"}), "pin_y": (("time", "pin"), x / 1e3)},
-                    coords={"time": [0.0, 1.0], "pin": [0, 1]})
+    ds = xr.Dataset(
+        {"pin_x": (("time", "pin"), x, {"units": "m"}), "pin_y": (("time", "pin"), x / 1e3)},
+        coords={"time": [0.0, 1.0], "pin": [0, 1]},
+    )
     write_netcdf(ds, tmp_path / "c.nc", storage="compact")
     back = xr.load_dataset(tmp_path / "c.nc")
     assert back.pin_x.dtype == np.float64 and np.array_equal(back.pin_x.values, x, equal_nan=True)
@@ -86,18 +90,38 @@ def test_bad_storage_names_the_value_and_what_is_allowed(tmp_path):
         storage.check_storage("small")
     p = tmp_path / "s.toml"
     p.write_text("[study]\nname = 's'\nstorage = 'tiny'\n")
-    with pytest.raises(StudyError, match=r"\[study\] storage = 'tiny' is not allowed: expected full or compact"):
+    with pytest.raises(
+        StudyError, match=r"\[study\] storage = 'tiny' is not allowed: expected full or compact"
+    ):
         load_study(p)
-    r = subprocess.run([sys.executable, "-c", "from trackbench.cli import main; main()", "run", "--storage", "x",
-                        "--out", str(tmp_path)], capture_output=True, text=True, timeout=120)
-    assert r.returncode == 2 and r.stderr.strip() == "error: --storage 'x' is not allowed: expected full or compact"
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from trackbench.cli import main; main()",
+            "run",
+            "--storage",
+            "x",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert (
+        r.returncode == 2
+        and r.stderr.strip() == "error: --storage 'x' is not allowed: expected full or compact"
+    )
     assert not list(tmp_path.glob("*.nc"))
 
 
 def test_study_with_compact_storage_has_the_same_summary(tmp_path):
     p = tmp_path / "c.toml"
-    p.write_text("[study]\nname = 'c'\nstorage = 'compact'\n[scenario]\nduration = 0.1\noutput_interval = 0.001\n"
-                 "[grid]\nspeed = [8.0, 12.0]\n")
+    p.write_text(
+        "[study]\nname = 'c'\nstorage = 'compact'\n[scenario]\nduration = 0.1\noutput_interval = 0.001\n"
+        "[grid]\nspeed = [8.0, 12.0]\n"
+    )
     compact = run_study(p, workers=2, output=tmp_path / "c", quiet=True)
     full = run_study(p, workers=2, output=tmp_path / "f", quiet=True, storage="full")
     assert compact.problem() is None and full.problem() is None
@@ -110,14 +134,30 @@ def test_study_with_compact_storage_has_the_same_summary(tmp_path):
         with xr.open_dataset(c / "timeseries.nc") as ds:
             assert ds.attrs["storage"] == "compact" and ds.link_tension.encoding["dtype"] == np.float32
         for name in ("timeseries.nc", "recording.rrd"):
-            assert (c / name).stat().st_size < (f / name).stat().st_size, name   # (short runs: mostly headers)
-    assert "storage = \"compact\"" in (tmp_path / "c" / "study.toml").read_text()
+            assert (c / name).stat().st_size < (f / name).stat().st_size, name  # (short runs: mostly headers)
+    assert 'storage = "compact"' in (tmp_path / "c" / "study.toml").read_text()
 
 
 def test_run_command_with_compact_storage(tmp_path):
-    r = subprocess.run([sys.executable, "-c", "from trackbench.cli import main; main()", "run", "--storage", "compact",
-                        "--duration", "0.05", "--set", "output_interval=0.001", "--out", str(tmp_path)],
-                       capture_output=True, text=True, timeout=300)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from trackbench.cli import main; main()",
+            "run",
+            "--storage",
+            "compact",
+            "--duration",
+            "0.05",
+            "--set",
+            "output_interval=0.001",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert r.returncode == 0, r.stderr
     with xr.open_dataset(tmp_path / "paper_step.nc") as ds:
         assert ds.attrs["storage"] == "compact" and ds.pin_x.encoding["dtype"] == np.int32

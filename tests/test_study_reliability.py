@@ -25,7 +25,7 @@ from trackbench.study.runner import confirm
 
 REPO = Path(__file__).resolve().parents[1]
 CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
-FAST = 'duration = 0.02\noutput_interval = 0.001\nrecord = { enabled = false }\n'
+FAST = "duration = 0.02\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 ENV = {**os.environ, "PYTHONPATH": str(REPO), "NUMBA_CACHE_DIR": os.environ.get("NUMBA_CACHE_DIR", "")}
 if not ENV["NUMBA_CACHE_DIR"]:
     del ENV["NUMBA_CACHE_DIR"]
@@ -45,15 +45,20 @@ def cli(args, cwd, timeout=300):
 
 def _unshare_works():
     try:
-        r = subprocess.run(["unshare", "-rmu", "sh", "-c", "hostname x && mount -t tmpfs tmpfs /mnt"],
-                           capture_output=True, timeout=10)
+        r = subprocess.run(
+            ["unshare", "-rmu", "sh", "-c", "hostname x && mount -t tmpfs tmpfs /mnt"],
+            capture_output=True,
+            timeout=10,
+        )
         return r.returncode == 0
     except (OSError, subprocess.TimeoutExpired):
         return False
 
 
-needs_unshare = pytest.mark.skipif(shutil.which("unshare") is None or not _unshare_works(),
-                                   reason="needs unshare (user + mount + uts namespaces) to fake another node")
+needs_unshare = pytest.mark.skipif(
+    shutil.which("unshare") is None or not _unshare_works(),
+    reason="needs unshare (user + mount + uts namespaces) to fake another node",
+)
 
 
 def _stop(procs):
@@ -75,23 +80,61 @@ def dask_cluster(cwd, workers):
     """A `dask scheduler` and the given `dask worker` commands (argument prefixes, e.g. an
     unshare wrapper), all started in ``cwd`` on 127.0.0.1; yields the scheduler address."""
     from dask.distributed import Client
+
     cwd.mkdir(parents=True, exist_ok=True)
     sched = cwd / "scheduler.json"
     procs = []
     log = open(cwd / "dask.log", "w")
     try:
-        procs.append(subprocess.Popen([DASK, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-                                       "--scheduler-file", str(sched)], cwd=cwd, env=ENV, stdout=log,
-                                      stderr=subprocess.STDOUT, start_new_session=True))
+        procs.append(
+            subprocess.Popen(
+                [
+                    DASK,
+                    "scheduler",
+                    "--host",
+                    "127.0.0.1",
+                    "--port",
+                    "0",
+                    "--no-dashboard",
+                    "--scheduler-file",
+                    str(sched),
+                ],
+                cwd=cwd,
+                env=ENV,
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        )
         deadline = time.time() + 60
         while not sched.exists() and time.time() < deadline:
             time.sleep(0.1)
         address = json.loads(sched.read_text())["address"]
         for i, prefix in enumerate(workers):
-            procs.append(subprocess.Popen(prefix + [DASK, "worker", address, "--nworkers", "1", "--nthreads", "1",
-                                                    "--host", "127.0.0.1", "--no-dashboard", "--name", f"w{i}"],
-                                          cwd=cwd, env=ENV, stdout=log, stderr=subprocess.STDOUT,
-                                          start_new_session=True))
+            procs.append(
+                subprocess.Popen(
+                    prefix
+                    + [
+                        DASK,
+                        "worker",
+                        address,
+                        "--nworkers",
+                        "1",
+                        "--nthreads",
+                        "1",
+                        "--host",
+                        "127.0.0.1",
+                        "--no-dashboard",
+                        "--name",
+                        f"w{i}",
+                    ],
+                    cwd=cwd,
+                    env=ENV,
+                    stdout=log,
+                    stderr=subprocess.STDOUT,
+                    start_new_session=True,
+                )
+            )
         with Client(address, timeout="30s") as c:
             c.wait_for_workers(len(workers), timeout=120)
         yield address
@@ -101,6 +144,7 @@ def dask_cluster(cwd, workers):
 
 
 # --- 1. dask workers in another working directory / on "another node" -------------------
+
 
 def test_dask_workers_started_elsewhere_write_into_the_study_folder(tmp_path):
     """The issue's case: relative results folder, workers started in another directory."""
@@ -120,7 +164,7 @@ def test_dask_workers_started_elsewhere_write_into_the_study_folder(tmp_path):
         assert rec["status"] == "completed"
         xr.load_dataset(out / "runs" / rid / "timeseries.nc")
         pids.add(rec["pid"])
-    assert not (elsewhere / "results").exists()   # nothing landed in the workers' directory
+    assert not (elsewhere / "results").exists()  # nothing landed in the workers' directory
     assert len(pids) >= 1
 
 
@@ -141,7 +185,7 @@ def test_dask_worker_on_a_node_without_the_folder_fails_the_runs_and_the_command
     else:
         (tmp_path / "stale.json").write_text("{}")
         setup = f"mount -t tmpfs tmpfs {out} && cp {tmp_path / 'stale.json'} {out}/runs.json"
-    node = ["unshare", "-rmu", "sh", "-c", f"hostname other-node && {setup} && exec \"$0\" \"$@\""]
+    node = ["unshare", "-rmu", "sh", "-c", f'hostname other-node && {setup} && exec "$0" "$@"']
     with dask_cluster(elsewhere, [node]) as address:
         r = cli(["study", "run", "nf.toml", "--executor", "dask", "--scheduler", address], here)
     assert r.returncode == 1, r.stdout + r.stderr
@@ -162,9 +206,13 @@ def test_worker_reasons_name_the_folder_and_the_host(tmp_path):
     s = load_study(write_study(tmp_path, "w", speeds=(5.0,)), output=tmp_path / "w")
     run = s.runs[0]
     host = executors.socket.gethostname()
-    for output, expect in [("results/w", "is not an absolute path"),
-                           (str(tmp_path / "nowhere"), f"{tmp_path / 'nowhere'} does not exist on worker host {host}")]:
-        rec = executors.execute_run({"run_id": run.run_id, "output": output, "scenario": run.scenario, "meta": {}})
+    for output, expect in [
+        ("results/w", "is not an absolute path"),
+        (str(tmp_path / "nowhere"), f"{tmp_path / 'nowhere'} does not exist on worker host {host}"),
+    ]:
+        rec = executors.execute_run(
+            {"run_id": run.run_id, "output": output, "scenario": run.scenario, "meta": {}}
+        )
         assert rec["status"] == "failed" and expect in rec["status_message"], rec["status_message"]
     assert not (tmp_path / "nowhere").exists() and not Path("results/w").exists()
 
@@ -173,7 +221,13 @@ def test_coordinator_rejects_a_completed_run_whose_netcdf_does_not_open(tmp_path
     s = load_study(write_study(tmp_path, "c", speeds=(5.0,)), output=tmp_path / "c")
     store.write_json(s.output / "runs.json", {})
     run = s.runs[0]
-    task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}, "attempt_id": "a1"}
+    task = {
+        "run_id": run.run_id,
+        "output": str(s.output),
+        "scenario": run.scenario,
+        "meta": {},
+        "attempt_id": "a1",
+    }
     rec = executors.execute_run(task)
     assert confirm(task, rec) is rec and rec["status"] == "completed"
     nc = store.run_dir(s.output, run.run_id) / "timeseries.nc"
@@ -189,7 +243,7 @@ def test_coordinator_rejects_a_completed_run_whose_netcdf_does_not_open(tmp_path
 
 # --- 3. a worker process killed mid-run ----------------------------------------------------
 
-LONG = 'duration = 0.5\noutput_interval = 0.001\nrecord = { enabled = false }\n'
+LONG = "duration = 0.5\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 
 @pytest.fixture(scope="module")
@@ -213,6 +267,7 @@ def _in_thread(fn):
             result["error"] = e
         finally:
             stop.set()
+
     th = threading.Thread(target=body)
     th.start()
     return th, result, stop
@@ -225,7 +280,7 @@ def _same_as_reference(o, out, reference):
     assert list(o.summary.run_id) == list(ref.summary.run_id) and o.summary.run_id.is_unique
     recs = [store.read_run(out, rid) for rid in o.summary.run_id]
     assert all(r["status"] == "completed" for r in recs)
-    assert not list(out.rglob(".*.tmp*"))            # no half-written file of a killed try is left
+    assert not list(out.rglob(".*.tmp*"))  # no half-written file of a killed try is left
     for rid, rec in zip(o.summary.run_id, recs):
         a = xr.load_dataset(store.run_dir(out, rid) / "timeseries.nc")
         b = xr.load_dataset(store.run_dir(ref_out, rid) / "timeseries.nc")
@@ -239,6 +294,7 @@ def _same_as_reference(o, out, reference):
 def test_killed_pool_worker_run_retried_once_counted_bit_for_bit(tmp_path, reference):
     """Once a run has started (its folder exists, no run.json yet), SIGKILL a pool worker."""
     import multiprocessing
+
     out = tmp_path / "killed"
     th, result, stop = _in_thread(lambda: run_study(reference[0], workers=2, output=out, quiet=True))
     killed = None
@@ -253,24 +309,29 @@ def test_killed_pool_worker_run_retried_once_counted_bit_for_bit(tmp_path, refer
     assert not th.is_alive() and "error" not in result, result.get("error")
     assert killed is not None
     recs = _same_as_reference(result["outcome"], out, reference)
-    assert max(r["attempt"] for r in recs) == 2     # the kill hit runs in flight; they ran again once
+    assert max(r["attempt"] for r in recs) == 2  # the kill hit runs in flight; they ran again once
 
 
 def test_killed_dask_worker_run_rescheduled_once_counted_bit_for_bit(tmp_path, reference):
     """A real scheduler with two workers; SIGKILL the worker process that is running a run."""
     pytest.importorskip("dask.distributed")
     from dask.distributed import Client
+
     out = tmp_path / "killed"
     with dask_cluster(tmp_path / "elsewhere", [[], []]) as address, Client(address, timeout="30s") as c:
         pids = c.run(os.getpid)
-        th, result, stop = _in_thread(lambda: run_study(reference[0], executor="dask", scheduler=address,
-                                                        output=out, quiet=True))
+        th, result, stop = _in_thread(
+            lambda: run_study(reference[0], executor="dask", scheduler=address, output=out, quiet=True)
+        )
         killed, deadline = None, time.time() + 120
         while killed is None and not stop.is_set() and time.time() < deadline:
             for w, keys in c.processing().items():
                 rids = [str(k).removeprefix("trackbench-run-") for k in keys]
-                mid_run = [r for r in rids if (out / "runs" / r).is_dir()
-                           and not (out / "runs" / r / "run.json").exists()]
+                mid_run = [
+                    r
+                    for r in rids
+                    if (out / "runs" / r).is_dir() and not (out / "runs" / r / "run.json").exists()
+                ]
                 if mid_run:
                     os.kill(pids[w], signal.SIGKILL)
                     killed = (mid_run[0], pids[w])
@@ -280,7 +341,7 @@ def test_killed_dask_worker_run_rescheduled_once_counted_bit_for_bit(tmp_path, r
     assert not th.is_alive() and "error" not in result, result.get("error")
     assert killed is not None
     _same_as_reference(result["outcome"], out, reference)
-    assert store.read_run(out, killed[0])["pid"] != killed[1]   # finished by another process
+    assert store.read_run(out, killed[0])["pid"] != killed[1]  # finished by another process
 
 
 def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
@@ -316,12 +377,13 @@ def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
 
         def shutdown(self, wait=True, cancel_futures=False):
             pass
+
     monkeypatch.setattr(executors, "_new_pool", lambda workers: Pool())
     monkeypatch.setattr(executors, "wait", lambda futs, return_when: None)
     notes = []
     tasks = [{"run_id": f"r{i}", "meta": {}, "scenario": {}} for i in range(4)]
     got = list(executors.run_local(tasks, workers=2, notify=notes.append))
-    assert sorted(t["run_id"] for t, _ in got) == ["r0", "r1", "r2", "r3"]   # each once
+    assert sorted(t["run_id"] for t, _ in got) == ["r0", "r1", "r2", "r3"]  # each once
     rec = {t["run_id"]: r for t, r in got}
     assert rec["r1"]["status"] == "failed" and rec["r1"]["attempt"] == executors.MAX_ATTEMPTS == 3
     assert "died or could not be reached (3 times)" in rec["r1"]["status_message"]
@@ -331,6 +393,7 @@ def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
 
 
 # --- 4. disk full and other reasons a user can act on -----------------------------------------
+
 
 def _serial(tasks, workers=2, notify=None, on_running=None):
     """The local executor without its process pool, so that monkeypatches reach the worker code."""
@@ -350,6 +413,7 @@ def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tm
             Path(path).with_name(".timeseries.nc.x.tmp").write_bytes(b"half")  # cleaned by the coordinator
             raise OSError(errno.ENOSPC, "No space left on device")
         return real(ds, path, storage)
+
     monkeypatch.setattr(executors, "run_local", _serial)
     monkeypatch.setattr(store, "write_timeseries", write)
     o = run_study(p, output=out, quiet=True)
@@ -359,9 +423,9 @@ def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tm
     assert f"no space left on the device holding {out / 'runs' / victim}" in msg and "MB free" in msg
     rec = store.read_run(out, victim)
     assert rec["exception"] == "OSError: [Errno 28] No space left on device" and rec["status_message"] == msg
-    assert sorted(os.listdir(out / "runs" / victim)) == ["run.json"]   # nothing partial
+    assert sorted(os.listdir(out / "runs" / victim)) == ["run.json"]  # nothing partial
     monkeypatch.undo()
-    o = run_study(p, output=out, quiet=True)                          # space again: the real pool
+    o = run_study(p, output=out, quiet=True)  # space again: the real pool
     assert o.problem() is None and o.ran == 1 and o.skipped == 2
     assert list(o.summary.status) == ["completed"] * 3
 
@@ -374,8 +438,9 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
 
     def hdf(ds, path, storage="full"):
         raise RuntimeError("NetCDF: HDF error")
+
     monkeypatch.setattr(store, "write_timeseries", hdf)
-    rec = executors.execute_run(task)          # plenty of space: the error as it is
+    rec = executors.execute_run(task)  # plenty of space: the error as it is
     assert rec["status_message"] == "RuntimeError: NetCDF: HDF error"
     Usage = namedtuple("Usage", "total used free")
     monkeypatch.setattr(executors.shutil, "disk_usage", lambda p: Usage(10**9, 10**9, 0))
@@ -389,7 +454,9 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
 
 def test_reasons_for_permission_and_missing_paths():
     host = executors.socket.gethostname()
-    r = executors.failure_reason(PermissionError(errno.EACCES, "Permission denied", "/data/s/runs/x"), "/data/s")
+    r = executors.failure_reason(
+        PermissionError(errno.EACCES, "Permission denied", "/data/s/runs/x"), "/data/s"
+    )
     assert r.startswith(f"permission denied: /data/s/runs/x (host {host}, uid ")
     r = executors.failure_reason(FileNotFoundError(errno.ENOENT, "No such file", "/data/s"), "/data/s")
     assert r == f"/data/s does not exist on host {host}"
@@ -403,7 +470,8 @@ def test_permission_denied_on_a_full_disk_is_the_full_disk(tmp_path):
     exc = PermissionError(errno.EACCES, "Permission denied", str(tmp_path / ".timeseries.nc.x.tmp"))
     free = executors._free_bytes(tmp_path)
     assert executors.failure_reason(exc, tmp_path, need_bytes=free + 2**30).startswith(
-        f"no space left on the device holding {tmp_path}")
+        f"no space left on the device holding {tmp_path}"
+    )
     assert executors.failure_reason(exc, tmp_path, need_bytes=1000).startswith("permission denied: ")
     assert executors.failure_reason(exc, tmp_path).startswith("permission denied: ")
 
@@ -412,19 +480,27 @@ def test_permission_denied_on_a_full_disk_is_the_full_disk(tmp_path):
 def test_real_full_disk_then_rerun_with_space(tmp_path):
     """A 0.8 MB file system for 4 runs of about 0.32 MB each: the runs that do not fit fail
     saying the disk is full; once the file system is larger, a rerun completes exactly those."""
-    scen = 'duration = 0.05\nrecord = { enabled = false }\n'
+    scen = "duration = 0.05\nrecord = { enabled = false }\n"
     p = write_study(tmp_path, "full", speeds=(5.0, 6.0, 7.0, 8.0), scenario=scen)
     out, keep = tmp_path / "results" / "full", tmp_path / "kept"
     out.mkdir(parents=True)
     run = f"{sys.executable} -c 'from trackbench.cli import main; main()' study run {p} --workers 2"
-    script = (f"mount -t tmpfs -o size=800k tmpfs {out} || exit 99; "
-              f"{run} > {tmp_path}/1.out 2> {tmp_path}/1.err; echo $? > {tmp_path}/1.rc; "
-              f"cp -r {out} {tmp_path}/first; "
-              f"mount -o remount,size=20m {out}; "
-              f"{run} > {tmp_path}/2.out 2> {tmp_path}/2.err; echo $? > {tmp_path}/2.rc; "
-              f"cp -r {out} {keep}")
-    r = subprocess.run(["unshare", "-rm", "sh", "-c", script], cwd=tmp_path, env=ENV, capture_output=True,
-                       text=True, timeout=600)
+    script = (
+        f"mount -t tmpfs -o size=800k tmpfs {out} || exit 99; "
+        f"{run} > {tmp_path}/1.out 2> {tmp_path}/1.err; echo $? > {tmp_path}/1.rc; "
+        f"cp -r {out} {tmp_path}/first; "
+        f"mount -o remount,size=20m {out}; "
+        f"{run} > {tmp_path}/2.out 2> {tmp_path}/2.err; echo $? > {tmp_path}/2.rc; "
+        f"cp -r {out} {keep}"
+    )
+    r = subprocess.run(
+        ["unshare", "-rm", "sh", "-c", script],
+        cwd=tmp_path,
+        env=ENV,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert r.returncode == 0, r.stderr
     rc1, rc2 = (int((tmp_path / f"{i}.rc").read_text()) for i in (1, 2))
     first = pd.read_csv(tmp_path / "first" / "summary.csv")
@@ -436,5 +512,7 @@ def test_real_full_disk_then_rerun_with_space(tmp_path):
         assert not (tmp_path / "first" / "runs" / row.run_id / "timeseries.nc").exists()
     assert not list((tmp_path / "first").rglob(".*.tmp*"))
     assert rc2 == 0, (tmp_path / "2.err").read_text()
-    assert f"{len(bad)} run now, {4 - len(bad)} already completed, 0 failed" in (tmp_path / "2.out").read_text()
+    assert (
+        f"{len(bad)} run now, {4 - len(bad)} already completed, 0 failed" in (tmp_path / "2.out").read_text()
+    )
     assert list(pd.read_csv(keep / "summary.csv").status) == ["completed"] * 4

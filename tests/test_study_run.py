@@ -20,7 +20,7 @@ from trackbench.study.summary import write_summary
 
 REPO = Path(__file__).resolve().parents[1]
 CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
-FAST = 'duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n'
+FAST = "duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 
 def cli(args, cwd, timeout=300):
@@ -29,8 +29,11 @@ def cli(args, cwd, timeout=300):
 
 def files(folder):
     """path -> (inode, mtime_ns) of every file below folder."""
-    return {str(p.relative_to(folder)): (p.stat().st_ino, p.stat().st_mtime_ns)
-            for p in Path(folder).rglob("*") if p.is_file()}
+    return {
+        str(p.relative_to(folder)): (p.stat().st_ino, p.stat().st_mtime_ns)
+        for p in Path(folder).rglob("*")
+        if p.is_file()
+    }
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +41,9 @@ def sweep(tmp_path_factory):
     """The shipped speed sweep at 0.05 s through the CLI (2 workers), then a resume."""
     d = tmp_path_factory.mktemp("sweep")
     text = (REPO / "studies" / "speed_sweep.toml").read_text().replace("duration = 0.5", "duration = 0.05")
-    (d / "speed_sweep.toml").write_text(text.replace("solver = \"reduced\"", "solver = \"reduced\"\nrecord = { enabled = false }"))
+    (d / "speed_sweep.toml").write_text(
+        text.replace('solver = "reduced"', 'solver = "reduced"\nrecord = { enabled = false }')
+    )
     first = cli(["study", "run", "speed_sweep.toml"], d)
     snap = files(d / "results" / "speed_sweep" / "runs")
     second = cli(["study", "run", "speed_sweep.toml"], d)
@@ -51,16 +56,32 @@ def test_speed_sweep_cli_end_to_end(sweep):
     out = d / "results" / "speed_sweep"
     assert "15 runs, 15 run now, 0 already completed, 0 failed" in first.stdout
     assert "[15/15]" in first.stderr and "ETA" in first.stderr
-    progress = [line for line in first.stderr.splitlines() if "ETA" in line]   # one line a run, never wrapped
+    progress = [line for line in first.stderr.splitlines() if "ETA" in line]  # one line a run, never wrapped
     assert len(progress) == 15 and all(line.startswith("[") and line.endswith(" s)") for line in progress)
     df = pd.read_csv(out / "summary.csv")
     assert len(df) == 15 and set(df.status) == {"completed"}
     pq = pd.read_parquet(out / "summary.parquet")
     assert list(pq.columns) == list(df.columns)
-    for col in ["run_id", "status", "speed", "terrain.height", "peak_wheel1_force_y", "peak_wheel5_force_y",
-                "peak_wheel5_force_y_time", "peak_ground_force_y", "peak_ground_force_y_time", "peak_link_tension",
-                "peak_chassis_ay", "min_chassis_ay", "min_chassis_vx", "min_chassis_vx_time",
-                "first_compression_time", "max_energy_balance_error", "steps", "wall_time"]:
+    for col in [
+        "run_id",
+        "status",
+        "speed",
+        "terrain.height",
+        "peak_wheel1_force_y",
+        "peak_wheel5_force_y",
+        "peak_wheel5_force_y_time",
+        "peak_ground_force_y",
+        "peak_ground_force_y_time",
+        "peak_link_tension",
+        "peak_chassis_ay",
+        "min_chassis_ay",
+        "min_chassis_vx",
+        "min_chassis_vx_time",
+        "first_compression_time",
+        "max_energy_balance_error",
+        "steps",
+        "wall_time",
+    ]:
         assert col in df.columns, col
     assert sorted(set(df.speed)) == [5.0, 7.5, 10.0, 12.5, 15.0]
     assert (df.peak_ground_force_y > 1e5).all() and (df.steps > 0).all()
@@ -73,7 +94,9 @@ def test_speed_sweep_cli_end_to_end(sweep):
         assert rec["status"] == "completed" and rec["run_id"] == rid and rec["model_version"]
         assert rec["scenario"]["duration"] == 0.05
         ds = xr.load_dataset(out / "runs" / rid / "timeseries.nc")
-        assert float(ds.peak_ground_force_y) == pytest.approx(df.set_index("run_id").loc[rid, "peak_ground_force_y"])
+        assert float(ds.peak_ground_force_y) == pytest.approx(
+            df.set_index("run_id").loc[rid, "peak_ground_force_y"]
+        )
         assert json.loads(ds.attrs["scenario"])["speed"] == rec["params"]["speed"]
 
 
@@ -95,7 +118,7 @@ def test_status_and_summary_commands(sweep):
 def test_open_study_and_dataset(sweep):
     d = sweep[0]
     df = tb.open_study(d / "speed_sweep.toml")  # relative output: resolved against the cwd
-    assert (df.status == "pending").all()       # the test's cwd is not the study's
+    assert (df.status == "pending").all()  # the test's cwd is not the study's
     df = tb.open_study(d / "results" / "speed_sweep")
     assert len(df) == 15 and (df.status == "completed").all()
     ds = tb.open_study(d / "results" / "speed_sweep", run=df.run_id[3][:6])
@@ -124,6 +147,7 @@ def test_runs_of_an_edited_grid_are_kept_and_said(tmp_path):
     """A grid edited (or a new model version: run ids include it) leaves run folders that belong
     to no run of the study: kept, not in the summary, and the report says how many."""
     from trackbench.study.runner import report
+
     p = tmp_path / "g.toml"
     p.write_text(f"[study]\nname = 'g'\n[scenario]\n{FAST}[grid]\nspeed = [6.0, 9.0]\n")
     first = run_study(p, workers=1, output=tmp_path / "out", quiet=True)
@@ -132,15 +156,23 @@ def test_runs_of_an_edited_grid_are_kept_and_said(tmp_path):
     second = run_study(p, workers=1, output=tmp_path / "out", quiet=True)
     assert second.skipped == 1 and second.others == 1 and len(second.summary) == 1
     assert "study g: 1 run, 0 run now, 1 already completed" in report(second)
-    assert "1 other run folder in " in report(second) and len(list((tmp_path / "out" / "runs").iterdir())) == 2
+    assert (
+        "1 other run folder in " in report(second) and len(list((tmp_path / "out" / "runs").iterdir())) == 2
+    )
     r = cli(["study", "status", str(tmp_path / "out")], tmp_path)
-    assert r.returncode == 0 and "study g: 1 run: 1 done, 0 failed, 0 pending" in r.stdout and "1 other run folder kept" in r.stdout
+    assert (
+        r.returncode == 0
+        and "study g: 1 run: 1 done, 0 failed, 0 pending" in r.stdout
+        and "1 other run folder kept" in r.stdout
+    )
 
 
 def test_failed_run_is_isolated_and_reported(tmp_path):
     p = tmp_path / "fail.toml"
-    p.write_text(f"[study]\nname = 'fail'\n[scenario]\n{FAST}"
-                 "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n")
+    p.write_text(
+        f"[study]\nname = 'fail'\n[scenario]\n{FAST}"
+        "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n"
+    )
     r = cli(["study", "run", str(p)], tmp_path)
     assert r.returncode == 1
     assert "1 of 3 runs failed" in r.stderr
@@ -155,11 +187,18 @@ def test_failed_run_is_isolated_and_reported(tmp_path):
 
 def test_kill_9_mid_study_then_resume(tmp_path):
     p = tmp_path / "k.toml"
-    p.write_text("[study]\nname = 'k'\n[scenario]\nduration = 0.3\nrecord = { enabled = false }\n"
-                 "[grid]\nspeed = { start = 5.0, stop = 12.0, step = 1.0 }\n")
+    p.write_text(
+        "[study]\nname = 'k'\n[scenario]\nduration = 0.3\nrecord = { enabled = false }\n"
+        "[grid]\nspeed = { start = 5.0, stop = 12.0, step = 1.0 }\n"
+    )
     out = tmp_path / "results" / "k"
-    proc = subprocess.Popen(CLI + ["study", "run", str(p), "--workers", "1"], cwd=tmp_path,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    proc = subprocess.Popen(
+        CLI + ["study", "run", str(p), "--workers", "1"],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
     deadline = time.time() + 120
     while time.time() < deadline and len(list(out.glob("runs/*/run.json"))) < 2:
         time.sleep(0.05)
@@ -177,8 +216,8 @@ def test_kill_9_mid_study_then_resume(tmp_path):
     assert r.returncode == 0, r.stderr
     assert f"{8 - len(done)} run now, {len(done)} already completed" in r.stdout
     after = files(out / "runs")
-    assert {k: after[k] for k in kept} == kept      # completed runs untouched
-    assert not list(out.rglob(".*.tmp*"))           # leftovers of the killed run cleaned
+    assert {k: after[k] for k in kept} == kept  # completed runs untouched
+    assert not list(out.rglob(".*.tmp*"))  # leftovers of the killed run cleaned
     df = pd.read_csv(out / "summary.csv")
     assert len(df) == 8 and (df.status == "completed").all()
 
@@ -201,8 +240,10 @@ def test_second_study_run_on_the_same_folder_exits_clearly(tmp_path):
 def test_dask_local_cluster(tmp_path):
     pytest.importorskip("dask.distributed")
     p = tmp_path / "d.toml"
-    p.write_text(f"[study]\nname = 'd'\noutput = 'dd'\n[scenario]\n{FAST}"
-                 "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n")
+    p.write_text(
+        f"[study]\nname = 'd'\noutput = 'dd'\n[scenario]\n{FAST}"
+        "[[runs]]\nspeed = 5.0\n[[runs]]\nspeed = 6.0\nmax_steps = 10\n[[runs]]\nspeed = 7.0\n"
+    )
     o = run_study(p, workers=2, executor="dask", output=tmp_path / "dd", quiet=True)
     assert list(o.summary.status) == ["completed", "failed", "completed"] and o.failed_total == 1
     recs = [store.read_run(tmp_path / "dd", rid) for rid in o.summary.run_id]
@@ -218,11 +259,18 @@ def test_replicates_statistics_and_flags(tmp_path):
     assert [r.scenario["seed"] for r in s.runs] == [1, 2, 3, 1, 2, 3]
     for r in s.runs:
         ground = 1000.0 * (1 + (0.1 if r.variant == 0 else 0.01) * r.replicate)
-        res = {"peak_ground_force_y": ground, "peak_link_tension": 50.0, "peak_chassis_ay": 2.0,
-               "min_chassis_ay": -3.0, "min_chassis_vx": 5.0}
+        res = {
+            "peak_ground_force_y": ground,
+            "peak_link_tension": 50.0,
+            "peak_chassis_ay": 2.0,
+            "min_chassis_ay": -3.0,
+            "min_chassis_vx": 5.0,
+        }
         res.update({f"peak_wheel{w}_force_y": 10.0 for w in range(1, 6)})
-        store.write_json(store.run_dir(s.output, r.run_id) / "run.json",
-                         {"run_id": r.run_id, "status": "completed", "results": res})
+        store.write_json(
+            store.run_dir(s.output, r.run_id) / "run.json",
+            {"run_id": r.run_id, "status": "completed", "results": res},
+        )
     df, rep = write_summary(s)
     assert len(df) == 6 and list(rep.speed) == [5.0, 6.0]
     assert rep.peak_ground_force_y_median.tolist() == [1100.0, 1010.0]
@@ -237,15 +285,19 @@ def test_replicates_run_with_distinct_perturbed_starts(tmp_path):
     p.write_text(f"[study]\nname = 'rr'\nreplicates = 2\n[scenario]\n{FAST}")
     o = run_study(p, workers=2, output=tmp_path / "rr", quiet=True)
     assert list(o.summary.status) == ["completed", "completed"] and len(o.replicates) == 1
-    y = [xr.load_dataset(store.run_dir(tmp_path / "rr", rid) / "timeseries.nc").pin_y[0].values
-         for rid in o.summary.run_id]
-    assert 0 < np.abs(y[0] - y[1]).max() < 1e-8   # the 1e-9 m nudge, seeded differently
+    y = [
+        xr.load_dataset(store.run_dir(tmp_path / "rr", rid) / "timeseries.nc").pin_y[0].values
+        for rid in o.summary.run_id
+    ]
+    assert 0 < np.abs(y[0] - y[1]).max() < 1e-8  # the 1e-9 m nudge, seeded differently
 
 
 def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
     p = tmp_path / "a.toml"
-    p.write_text("[study]\nname = 'a'\n[scenario]\noutput_interval = 0.001\nrecord = { enabled = false }\n"
-                 "[[runs]]\nduration = 0.03\n[[runs]]\nduration = 0.05\n")
+    p.write_text(
+        "[study]\nname = 'a'\n[scenario]\noutput_interval = 0.001\nrecord = { enabled = false }\n"
+        "[[runs]]\nduration = 0.03\n[[runs]]\nduration = 0.05\n"
+    )
     run_study(p, workers=2, output=tmp_path / "a", quiet=True)
     ds = tb.open_study_dataset(tmp_path / "a")
     assert ds.sizes["run"] == 2 and ds.sizes["time"] == 51
@@ -254,6 +306,7 @@ def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
     assert list(ds.duration.values) == [0.03, 0.05]
     # without dask (the README's plain install) the same dataset, read into memory
     from trackbench.study import summary
+
     monkeypatch.setattr(summary, "_have_dask", lambda: False)
     eager = tb.open_study_dataset(tmp_path / "a")
     assert eager.chunks == {} and eager.identical(ds.load())
@@ -267,24 +320,32 @@ def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
 def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     """A recording writer that raises: the run completes and run.json says why."""
     import types
+
     from trackbench.study.executors import execute_run
+
     mod = types.ModuleType("trackbench.replay.record")
 
     def boom(ds, path, every=1, signal_every=1):
         Path(path).write_text("partial")
         raise RuntimeError("disk full")
+
     mod.write_recording = boom
     monkeypatch.setitem(sys.modules, "trackbench.replay.record", mod)
-    s = load_study(_write(tmp_path, "[scenario]\nduration = 0.02\noutput_interval = 0.001\n"), output=tmp_path / "o")
+    s = load_study(
+        _write(tmp_path, "[scenario]\nduration = 0.02\noutput_interval = 0.001\n"), output=tmp_path / "o"
+    )
     run = s.runs[0]
     store.write_json(s.output / "runs.json", {})  # a worker writes only into an existing study folder
     task = {"run_id": run.run_id, "output": str(s.output), "scenario": run.scenario, "meta": {}}
     rec = execute_run(task)
-    assert rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]
+    assert (
+        rec["status"] == "completed" and "recording failed: RuntimeError: disk full" in rec["recording_error"]
+    )
     assert sorted(os.listdir(store.run_dir(s.output, run.run_id))) == ["run.json", "timeseries.nc"]
 
     def ok(ds, path, every=1, signal_every=1):
         Path(path).write_text(f"rrd every={every}")
+
     mod.write_recording = ok
     rec = execute_run(task)
     assert rec["recording"] == "recording.rrd" and "recording_error" not in rec
@@ -300,25 +361,35 @@ def _write(tmp_path, text):
 
 def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     import io
+
     from trackbench.study.runner import _Progress
-    runs = [{"run_id": "a1", "status": "completed"}, {"run_id": "b2", "status": "failed",
-                                                      "status_message": "NaN " + "x" * 200},
-            {"run_id": "c3", "status": "completed"}]
+
+    runs = [
+        {"run_id": "a1", "status": "completed"},
+        {"run_id": "b2", "status": "failed", "status_message": "NaN " + "x" * 200},
+        {"run_id": "c3", "status": "completed"},
+    ]
     log = io.StringIO()
     p = _Progress(3, 1, stream=log, workers=2)
     for r in runs:
         p.update(r)
     p.close()
     lines = log.getvalue().splitlines()
-    assert lines[0] == "3 runs to do, 1 already completed" and len(lines) == 4 and "\x1b" not in log.getvalue()
-    assert lines[2].startswith("[2/3] b2 failed: NaN xxx") and lines[2].endswith("(done 1  failed 1  running 1  of 3, ETA 0 s)")
+    assert (
+        lines[0] == "3 runs to do, 1 already completed" and len(lines) == 4 and "\x1b" not in log.getvalue()
+    )
+    assert lines[2].startswith("[2/3] b2 failed: NaN xxx") and lines[2].endswith(
+        "(done 1  failed 1  running 1  of 3, ETA 0 s)"
+    )
     term = io.StringIO()
     p = _Progress(3, 0, stream=term, workers=2, terminal=True)
     p.running(2)
     p.update(runs[0])
     p.close()
     out = term.getvalue()
-    assert "\x1b" in out and "done 1  failed 0  running 2  of 3" in out and "ETA" in out and "[1/3]" not in out
+    assert (
+        "\x1b" in out and "done 1  failed 0  running 2  of 3" in out and "ETA" in out and "[1/3]" not in out
+    )
 
 
 def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
@@ -327,7 +398,9 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
     and the ETA does not count that wait once per run."""
     import io
     import json
+
     from trackbench.study.runner import _Progress
+
     flag = tmp_path / "flag.json"
     flag.write_text(json.dumps({"compiling": True, "seconds": 0.0}))
     term = io.StringIO()
@@ -341,17 +414,26 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
     p.update({"run_id": "a1", "status": "completed"})
     lines = log.getvalue().splitlines()
     assert lines[1].startswith("(the workers waited 3600 s for the model to compile")
-    assert lines[2].endswith("ETA 0 s)")     # not 7200 s: the hour of compiling is not per run
+    assert lines[2].endswith("ETA 0 s)")  # not 7200 s: the hour of compiling is not per run
 
 
 def test_one_warm_scenario_per_kind_of_compiled_model():
     from trackbench.study.warming import warm_kinds
+
     paper = tb.Scenario.paper().to_dict()
-    runs = [paper, {**paper, "speed": 5.0}, tb.Scenario.paper(**{"terrain.soil": "lete_sand"}).to_dict(),
-            tb.Scenario.paper(**{"track.layout": "closed"}).to_dict(), tb.Scenario.paper(method="dop853").to_dict()]
+    runs = [
+        paper,
+        {**paper, "speed": 5.0},
+        tb.Scenario.paper(**{"terrain.soil": "lete_sand"}).to_dict(),
+        tb.Scenario.paper(**{"track.layout": "closed"}).to_dict(),
+        tb.Scenario.paper(method="dop853").to_dict(),
+    ]
     kinds = warm_kinds(runs)
-    assert [(k["track"]["layout"], k["method"]) for k in kinds] == [("paper", "dopri5"), ("closed", "dopri5"),
-                                                                    ("paper", "dop853")]
+    assert [(k["track"]["layout"], k["method"]) for k in kinds] == [
+        ("paper", "dopri5"),
+        ("closed", "dopri5"),
+        ("paper", "dop853"),
+    ]
 
 
 def test_workers_are_forks_of_a_single_threaded_preloaded_server():
@@ -359,9 +441,12 @@ def test_workers_are_forks_of_a_single_threaded_preloaded_server():
     one thread when it forked (trackbench/study/preload.py says why that makes forking safe)."""
     from trackbench.study import executors
     from trackbench.study.preload import facts
+
     pool = executors._new_pool(2)
     try:
         got = [f.result(timeout=300) for f in [pool.submit(facts) for _ in range(2)]]
     finally:
         pool.shutdown()
-    assert all(g["threads_at_fork"] == 1 and g["loop_signatures"] >= 1 and g["pid"] != os.getpid() for g in got)
+    assert all(
+        g["threads_at_fork"] == 1 and g["loop_signatures"] >= 1 and g["pid"] != os.getpid() for g in got
+    )

@@ -57,7 +57,9 @@ def _prune(base, target):
         except OSError:     # removed meanwhile by another process
             return None
     now = time.time()
-    folders = [(t, p) for p in base.iterdir() if p.is_dir() and p != target for t in [age(p)] if t is not None]
+    folders = [
+        (t, p) for p in base.iterdir() if p.is_dir() and p != target for t in [age(p)] if t is not None
+    ]
     for t, p in sorted(folders, reverse=True)[KEEP - 1:]:
         if now - t > IDLE:
             shutil.rmtree(p, ignore_errors=True)
@@ -90,9 +92,12 @@ class CompileNotice:
             def on_start(self, ev):
                 if notice._depth == 0:
                     if notice.seconds == 0.0 and notice.stream is not None:
-                        print("compiling the model for this kind of run (first use on this machine or after an "
-                              "upgrade: about a minute; later runs load it from the cache) ...",
-                              file=notice.stream, flush=True)
+                        print(
+                            "compiling the model for this kind of run (first use on this machine or after an "
+                            "upgrade: about a minute; later runs load it from the cache) ...",
+                            file=notice.stream,
+                            flush=True,
+                        )
                     notice._t0 = time.perf_counter()
                     notice._tell(True)
                 notice._depth += 1

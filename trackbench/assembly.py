@@ -8,15 +8,15 @@ import json
 
 import numpy as np
 
-from .model import layout as L
-from .model.bundles import arm_table, model_arrays, work_arrays
-from .model.parameters import arm_damping, pack, total_mass
+from .model.core import indices as L
+from .model.core.bundles import arm_table, model_arrays, work_arrays
+from .model.vehicle.parameters import arm_damping, pack, total_mass
 from .scenario import Scenario
 
 
 @functools.lru_cache(maxsize=32)
 def _equilibrium_cached(key):
-    from .model.equilibrium import solve_equilibrium
+    from .solvers.equilibrium.static import solve_equilibrium
     vehicle, track, gravity, contact, soil = json.loads(key)
     return solve_equilibrium(vehicle, track, gravity, contact, {int(k): v for k, v in soil.items()})
 
@@ -32,7 +32,7 @@ def _closed_key(scenario):
 
 @functools.lru_cache(maxsize=32)
 def _closed_parts_cached(key):
-    from .model.closed import closed_geometry, guide_table, loop_vector
+    from .model.vehicle.closed_track import closed_geometry, guide_table, loop_vector
     vehicle, track, gravity, contact, spr, idl, rol, drive, drawbar = json.loads(key)
     g = closed_geometry(vehicle, track, spr, idl, rol, frozenset({"track.n_links"}))
     c = 0.0
@@ -48,8 +48,8 @@ def closed_parts(scenario: Scenario):
 
 @functools.lru_cache(maxsize=32)
 def _loop_equilibrium_cached(key, soil):
-    from .model.closed import without_drawbar
-    from .model.equilibrium import solve_loop_equilibrium
+    from .model.vehicle.closed_track import without_drawbar
+    from .solvers.equilibrium.static import solve_loop_equilibrium
     vehicle, track, gravity, contact, *_ = json.loads(key)
     g, lp, guides = _closed_parts_cached(key)
     return solve_loop_equilibrium(vehicle, track, gravity, contact, g, without_drawbar(lp), guides,
@@ -69,7 +69,7 @@ def _loop_velocities(scenario, eq, y0):
     """The closed track moving at `speed` without slip on the ground: every pin runs round
     the loop (clockwise, along its neighbours' chord) at `speed` relative to the chassis,
     the sprocket turns to match."""
-    from .model import fixed_math as fm    # numba: loaded when first needed
+    from .model.core import fixed_math as fm  # numba: loaded when first needed
     nq = eq.q.size
     nw, n = scenario["vehicle.n_wheels"], scenario["track.n_links"]
     v = scenario["speed"]
@@ -111,17 +111,23 @@ RUT_CELLS_MAX = 2_000_000
 
 def soil_par(scenario):
     """{P_* index: value} of the scenario's soft soil, {} on rigid ground."""
-    from .model import fixed_math as fm    # numba: loaded when first needed
-    from .model.soil import resolve_soil
+    from .model.core import fixed_math as fm  # numba: loaded when first needed
+    from .model.ground.soil import resolve_soil
     soil = resolve_soil(scenario["terrain"].get("soil", "rigid"))
     if soil is None:
         return {}
     b = scenario["track.width"]
     area = b * scenario["track.link_length"]
-    return {L.P_SOIL: 1.0, L.P_SOIL_N: soil["n"], L.P_SOIL_K: soil["k_c"] / b + soil["k_phi"],
-            L.P_SOIL_KE: soil["unloading_stiffness"], L.P_PIN_AREA: area, L.P_SOIL_COHESION: soil["cohesion"] * area,
-            L.P_SOIL_TAN_PHI: float(fm.vtan(np.radians(soil["friction_angle"]))),
-            L.P_SOIL_SHEAR_K: soil["shear_modulus"]}
+    return {
+        L.P_SOIL: 1.0,
+        L.P_SOIL_N: soil["n"],
+        L.P_SOIL_K: soil["k_c"] / b + soil["k_phi"],
+        L.P_SOIL_KE: soil["unloading_stiffness"],
+        L.P_PIN_AREA: area,
+        L.P_SOIL_COHESION: soil["cohesion"] * area,
+        L.P_SOIL_TAN_PHI: float(fm.vtan(np.radians(soil["friction_angle"]))),
+        L.P_SOIL_SHEAR_K: soil["shear_modulus"],
+    }
 
 
 def _soil(scenario, eq, par):
@@ -155,8 +161,9 @@ class Model:
         self.closed = parts is not None
         loop, guides = (parts[1], parts[2]) if self.closed else (None, None)
         rut = _soil(scenario, eq, par)
-        self.arrays = model_arrays(par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides,
-                                   rut)
+        self.arrays = model_arrays(
+            par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides, rut
+        )
         self.work = work_arrays(self.arrays, self.nw, self.n_links)
         self.weight = eq.weight if self.closed else total_mass(v, tr) * scenario["gravity"]
         self.nq = L.n_coordinates(self.nw, self.n_links, self.closed)

@@ -51,18 +51,35 @@ def _main(version: bool = typer.Option(False, "--version", metavar="", callback=
 
 @app.command(cls=_Command)
 def run(
-    set_: List[str] = typer.Option([], "--set", "-s", metavar="NAME=VALUE", help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15"),
-    duration: Optional[float] = typer.Option(None, help="Simulated time (s); default: the scenario's (0.5 s)."),
-    out: Path = typer.Option(Path("out"), "--out", "-o", help="Folder for the netCDF file and the recording."),
-    name: Optional[str] = typer.Option(None, help="Scenario name, used for the file names; default: "
-                                                  "--set name=..., else paper_step."),
-    force: bool = typer.Option(False, "--force", metavar="", help="Replace OUT/NAME.nc (and .rrd) if they exist."),
-    storage: str = typer.Option("full", metavar=STORAGE, help="full (lossless) or compact (time histories at the resolution "
-                                             "results_schema.md states, a thinner recording)."),
+    set_: List[str] = typer.Option(
+        [],
+        "--set",
+        "-s",
+        metavar="NAME=VALUE",
+        help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15",
+    ),
+    duration: Optional[float] = typer.Option(
+        None, help="Simulated time (s); default: the scenario's (0.5 s)."
+    ),
+    out: Path = typer.Option(
+        Path("out"), "--out", "-o", help="Folder for the netCDF file and the recording."
+    ),
+    name: Optional[str] = typer.Option(
+        None, help="Scenario name, used for the file names; default: --set name=..., else paper_step."
+    ),
+    force: bool = typer.Option(
+        False, "--force", metavar="", help="Replace OUT/NAME.nc (and .rrd) if they exist."
+    ),
+    storage: str = typer.Option(
+        "full",
+        metavar=STORAGE,
+        help="full (lossless) or compact (time histories at the resolution "
+        "results_schema.md states, a thinner recording).",
+    ),
 ):
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
-    from .runner import run_one
     from .scenario import ScenarioError
+    from .single_run import run_one
     from .status import EquilibriumError
     try:
         text, ok = run_one(set_, duration, out, name, force, storage)
@@ -78,7 +95,7 @@ def run(
 @app.command(cls=_Command)
 def params():
     """List every parameter name with its paper value and what is allowed."""
-    from .runner import parameter_table
+    from .single_run import parameter_table
     typer.echo(parameter_table())
 
 
@@ -105,22 +122,39 @@ def _study_folder_or_fail(path: Path):
 @study_app.command("run", cls=_Command)
 def study_run(
     file: Path = typer.Argument(..., help="Study file (TOML), e.g. studies/speed_sweep.toml."),
-    workers: int = typer.Option(2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."),
-    executor: str = typer.Option("local", metavar="local|dask", help="local (process pool) or dask (dask.distributed)."),
-    scheduler: Optional[str] = typer.Option(None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."),
-    force: bool = typer.Option(False, "--force", metavar="", help="Rerun every run, also those already completed."),
-    output: Optional[Path] = typer.Option(None, "--output", "-o", help="Results folder; default: the study's "
-                                          "\\[study] output, else results/NAME (relative to the current directory)."),
-    storage: Optional[str] = typer.Option(None, metavar=STORAGE, help="full (lossless) or compact (time histories "
-                                                     "at the resolution results_schema.md states); default: the "
-                                                     "study's \\[study] storage, "
-                                                     "else full. Runs already completed keep their files."),
+    workers: int = typer.Option(
+        2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."
+    ),
+    executor: str = typer.Option(
+        "local", metavar="local|dask", help="local (process pool) or dask (dask.distributed)."
+    ),
+    scheduler: Optional[str] = typer.Option(
+        None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."
+    ),
+    force: bool = typer.Option(
+        False, "--force", metavar="", help="Rerun every run, also those already completed."
+    ),
+    output: Optional[Path] = typer.Option(
+        None,
+        "--output",
+        "-o",
+        help="Results folder; default: the study's "
+        "\\[study] output, else results/NAME (relative to the current directory).",
+    ),
+    storage: Optional[str] = typer.Option(
+        None,
+        metavar=STORAGE,
+        help="full (lossless) or compact (time histories "
+        "at the resolution results_schema.md states); default: the "
+        "study's \\[study] storage, "
+        "else full. Runs already completed keep their files.",
+    ),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    study = _load_study_or_fail(file, output)   # a bad study file fails here, before the solver libraries load
+    study = _load_study_or_fail(file, output)  # a bad study file fails here, before the solver libraries load
     from .study.executors import check_arguments, start_workers
-    from .study.warming import warm_kinds
     from .study.runner import check_output
+    from .study.warming import warm_kinds
     try:
         check_arguments(workers, executor, scheduler, storage)
         check_output(study)   # a folder that cannot be written, or that holds another study's results
@@ -142,7 +176,9 @@ def study_run(
     except RuntimeError as e:  # e.g. the dask scheduler cannot be reached
         _fail(str(e), code=1)
     except KeyboardInterrupt:
-        _fail("interrupted: completed runs are kept; run the same command again to finish the study", code=130)
+        _fail(
+            "interrupted: completed runs are kept; run the same command again to finish the study", code=130
+        )
     typer.echo(report(outcome))
     if outcome.problem():
         _fail(outcome.problem(), code=1)
@@ -164,12 +200,17 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
     from .study.summary import missing_folder
     study = _study_folder_or_fail(file)[0] if file.is_dir() else _load_study_or_fail(file)
     if not study.output.is_dir():
-        typer.echo(f"study {study.name}: {count(len(study.runs), 'run')}, all pending: {missing_folder(study)}")
+        typer.echo(
+            f"study {study.name}: {count(len(study.runs), 'run')}, all pending: {missing_folder(study)}"
+        )
         return
     counts, df = status_counts(study)
     kept = others_note(len(other_runs(study)))
-    typer.echo(f"study {study.name}: {count(len(study.runs), 'run')}: {counts['completed']} done, {counts['failed']} failed, "
-               f"{counts['pending']} pending ({study.output}){'; ' + kept if kept else ''}")
+    typer.echo(
+        f"study {study.name}: {count(len(study.runs), 'run')}: {counts['completed']} done, "
+        f"{counts['failed']} failed, "
+        f"{counts['pending']} pending ({study.output}){'; ' + kept if kept else ''}"
+    )
     for _, r in df[df.status == "failed"].iterrows():
         typer.echo(f"  failed {r.run_id}: {r.status_message}")
 
@@ -178,11 +219,15 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
 
 @app.command(cls=_Command)
 def view(
-    path: Path = typer.Argument(..., help="A run folder (recording.rrd inside), an .rrd or .nc file, or a study "
-                                          "(results folder or TOML) followed by RUN_ID."),
+    path: Path = typer.Argument(
+        ...,
+        help="A run folder (recording.rrd inside), an .rrd or .nc file, or a study "
+        "(results folder or TOML) followed by RUN_ID.",
+    ),
     run_id: Optional[str] = typer.Argument(None, help="Run id within a study (a unique prefix is enough)."),
 ):
-    """Open the rerun viewer on a run's recording (needs a display; otherwise says how to open it elsewhere)."""
+    """Open the rerun viewer on a run's recording (needs a display; otherwise says how to
+    open it elsewhere)."""
     from .replay.view import ViewError, open_viewer
     if path.suffix == ".toml" and path.is_file():
         path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
@@ -195,12 +240,22 @@ def view(
 
 @app.command(cls=_Command)
 def plot(
-    path: Path = typer.Argument(..., help="A run (.nc file or run folder) or a study (results folder or TOML)."),
-    out: Optional[Path] = typer.Option(None, "--out", "-o", help="Folder for the PNG files; default: "
-                                       "RUN_FOLDER/plots, NAME_plots beside a .nc file, STUDY/plots."),
-    times: Optional[str] = typer.Option(None, help="Times (s) of the configuration figure, comma-separated; "
-                                         "default: the paper's 0.1,0.35,0.45 for a run of its length, else three "
-                                         "times spread over the run."),
+    path: Path = typer.Argument(
+        ..., help="A run (.nc file or run folder) or a study (results folder or TOML)."
+    ),
+    out: Optional[Path] = typer.Option(
+        None,
+        "--out",
+        "-o",
+        help="Folder for the PNG files; default: "
+        "RUN_FOLDER/plots, NAME_plots beside a .nc file, STUDY/plots.",
+    ),
+    times: Optional[str] = typer.Option(
+        None,
+        help="Times (s) of the configuration figure, comma-separated; "
+        "default: the paper's 0.1,0.35,0.45 for a run of its length, else three "
+        "times spread over the run.",
+    ),
 ):
     """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
     from .replay.plots import plot_run, plot_study, remove_stale
@@ -208,7 +263,9 @@ def plot(
         tt = None if times is None else tuple(float(x) for x in times.split(",") if x.strip())
     except ValueError:
         _fail(f"--times {times!r}: expected numbers separated by commas, e.g. 0.1,0.35,0.45")
-    is_study = path.suffix == ".toml" or (path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir()))
+    is_study = path.suffix == ".toml" or (
+        path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir())
+    )
     if path.suffix == ".toml":
         path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
     if out is None:
@@ -237,6 +294,7 @@ def record(
 ):
     """Write (or rewrite) the rerun recording of an existing run."""
     import xarray as xr
+
     from .replay.plots import find_timeseries
     from .replay.record import RECORDING_NAME, write_recording
     try:
@@ -265,7 +323,9 @@ def main():
             e.show()
             sys.exit(0)
         where = e.ctx.command_path if e.ctx is not None else "trackbench"
-        typer.secho(f"error: {where}: {e.format_message()} (see '{where} --help')", fg=typer.colors.RED, err=True)
+        typer.secho(
+            f"error: {where}: {e.format_message()} (see '{where} --help')", fg=typer.colors.RED, err=True
+        )
         code = 2
     except typer.Abort:
         typer.secho("error: interrupted", fg=typer.colors.RED, err=True)

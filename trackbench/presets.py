@@ -4,8 +4,6 @@ docs/model.md ("The damped preset")."""
 
 import math
 
-from .model.contact_laws import damping_ratio_for_restitution
-
 # the paper's arm: inertia about the pivot 12.5 + 300 x 0.5^2 = 87.5 kg m^2, torsion bar
 # 191,000 N m/rad: c = 2 zeta sqrt(k_t I) = zeta x 8,180 N m s/rad
 ARM_CRITICAL = 2.0 * math.sqrt(191000.0 * 87.5)

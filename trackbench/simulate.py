@@ -7,10 +7,10 @@ The compiled solvers and xarray load on the first call, not at import.
 
 import time
 
-from .assembly import Model, equilibrium, initial_state
-from .assembly import closed_parts, soil_par  # noqa: F401  (the run's parts: part of this module's API)
-from .model.terrain import build_ground  # noqa: F401  (part of this module's API)
+from .assembly import Model, closed_parts, equilibrium, initial_state, soil_par  # noqa: F401  (the run's parts: part of this module's API)
+from .model.ground.terrain import build_ground  # noqa: F401  (part of this module's API)
 from .scenario import Scenario, ScenarioError
+from .solvers.registry import run_function
 
 
 def simulate(scenario: Scenario, progress=None):
@@ -25,10 +25,7 @@ def simulate(scenario: Scenario, progress=None):
         raise ScenarioError(str(e)) from None
     model = Model(scenario, eq, ground)
     y0 = initial_state(scenario, eq)
-    if scenario["solver"] == "lee":
-        from .solvers.lee import run as run_solver
-    else:
-        from .solvers.rk import run as run_solver
+    run_solver = run_function(scenario["solver"])
     from .output import build_dataset
     t_solve = time.perf_counter()
     result = run_solver(scenario, model, y0)

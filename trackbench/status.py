@@ -26,9 +26,15 @@ class Result(IntEnum):
 _MESSAGES = {
     Result.SUCCESSFUL: "run completed",
     Result.NAN: "the state became NaN or infinite (diverged)",
-    Result.STEP_SIZE_UNDERFLOW: "the step size fell below the minimum step (the solution is too stiff or discontinuous here)",
-    Result.WHEEL_THROUGH_TRACK: "a road wheel went through the track (wheel centre crossed a link's centre line)",
-    Result.CORNER_THROUGH_TRACK: "a ground corner went through the track (corner crossed a link's centre line)",
+    Result.STEP_SIZE_UNDERFLOW: (
+        "the step size fell below the minimum step (the solution is too stiff or discontinuous here)"
+    ),
+    Result.WHEEL_THROUGH_TRACK: (
+        "a road wheel went through the track (wheel centre crossed a link's centre line)"
+    ),
+    Result.CORNER_THROUGH_TRACK: (
+        "a ground corner went through the track (corner crossed a link's centre line)"
+    ),
     Result.MAX_STEPS: "the maximum number of steps was reached",
     Result.CONSTRAINT_ITERATION: "the Lagrange-multiplier iteration did not converge",
     Result.PIN_THROUGH_SPROCKET: "a track pin went into a sprocket tooth (it jumped the teeth)",

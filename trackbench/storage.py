@@ -29,7 +29,7 @@ COMPACT_FRAME_EVERY = 40      # compact recordings: the side view at every 40th 
 COMPACT_SIGNAL_EVERY = 10     # ... and the time series at every 10th (and the last)
 # the resolution of a compact time history, by kind (results_schema.md says it per variable)
 SIGNIFICANT_BITS = 16         # compact float32 histories keep 16 significant bits
-RELATIVE_ERROR = 2.0 ** -(SIGNIFICANT_BITS + 1) + 2.0 ** -24   # the rounding to 16 bits and to float32: 7.7e-6
+RELATIVE_ERROR = 2.0 ** -(SIGNIFICANT_BITS + 1) + 2.0**-24  # the rounding to 16 bits and to float32: 7.7e-6
 RESOLUTION = {"position": f"{POSITION_STEP * 1e6:g} um (packed int32)",
               "other": f"{SIGNIFICANT_BITS} significant bits (relative error <= {RELATIVE_ERROR:.1e})"}
 
@@ -86,8 +86,13 @@ def layout(name, var, storage):
             return np.dtype(np.int32), PACKED_FILL, {"scale_factor": POSITION_STEP, "add_offset": p[1],
                                                       "resolution": RESOLUTION["position"]}, p[0], {}
         return data.dtype, fill, {}, data, {}
-    return (np.dtype(np.float32), np.float32(np.nan), {"resolution": RESOLUTION["other"]}, data.astype(np.float32),
-            {"significant_digits": SIGNIFICANT_BITS, "quantize_mode": "BitRound"})
+    return (
+        np.dtype(np.float32),
+        np.float32(np.nan),
+        {"resolution": RESOLUTION["other"]},
+        data.astype(np.float32),
+        {"significant_digits": SIGNIFICANT_BITS, "quantize_mode": "BitRound"},
+    )
 
 
 def write(ds, path, storage="full"):

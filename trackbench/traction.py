@@ -24,8 +24,7 @@ import json
 
 import numpy as np
 
-from .model.soil import bekker_pressure, janosi_shear, resolve_soil, static_sinkage, wong_thrust
-
+from .model.ground.soil import bekker_pressure, janosi_shear, resolve_soil, static_sinkage, wong_thrust
 
 TRACK_STILL = 1e-3      # m/s: slower than this, the sprocket lays no track and there is no slip
 
@@ -107,7 +106,9 @@ def wong(fig, soil):
     soil sees (track_slip),
     and his compaction resistance b k z0^(n+1) / (n+1) at the sinkage z0 of the uniform
     pressure W / A (Theory of Ground Vehicles): (thrust, resistance) in N."""
-    thrust = wong_thrust(fig["area"], fig["weight"], fig["length"], min(max(fig["track_slip"], 0.0), 1.0), soil)
+    thrust = wong_thrust(
+        fig["area"], fig["weight"], fig["length"], min(max(fig["track_slip"], 0.0), 1.0), soil
+    )
     b = fig["area"] / fig["length"]
     z0 = static_sinkage(fig["weight"] / fig["area"], soil, b)
     resistance = b * float(bekker_pressure(z0, soil, b)) * z0 / (soil["n"] + 1.0)

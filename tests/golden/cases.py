@@ -15,9 +15,16 @@ CASES = {
     "paper_step": {},
     "paper_step_lee": {"solver": "lee"},
     "flat": {"terrain": {"kind": "flat"}, "duration": 0.2},
-    "sequence": {"duration": 0.3, "terrain": {
-        "kind": "sequence", "obstacles": [{"kind": "step", "height": 0.05, "first_contact_time": 0.03},
-                                          {"kind": "bump", "height": 0.05, "length": 0.3, "gap": 0.5}]}},
+    "sequence": {
+        "duration": 0.3,
+        "terrain": {
+            "kind": "sequence",
+            "obstacles": [
+                {"kind": "step", "height": 0.05, "first_contact_time": 0.03},
+                {"kind": "bump", "height": 0.05, "length": 0.3, "gap": 0.5},
+            ],
+        },
+    },
 }
 
 # attributes that vary from run to run (timings) or name the code, not the numbers
@@ -38,6 +45,7 @@ def fingerprint(ds):
 
 def simulate_case(name):
     import trackbench as tb
+
     return tb.simulate(tb.Scenario.from_dict(CASES[name]))
 
 
@@ -46,7 +54,9 @@ def differences(name, ds, expected):
     got = json.loads(json.dumps(fingerprint(ds), default=str))
     want = expected[name]
     arrays = sorted(k for k in set(want) | set(got) if k != "attrs" and want.get(k) != got.get(k))
-    attrs = sorted(k for k in set(want["attrs"]) | set(got["attrs"]) if want["attrs"].get(k) != got["attrs"].get(k))
+    attrs = sorted(
+        k for k in set(want["attrs"]) | set(got["attrs"]) if want["attrs"].get(k) != got["attrs"].get(k)
+    )
     return arrays, [f"{k}: {want['attrs'].get(k)!r} -> {got['attrs'].get(k)!r}" for k in attrs]
 
 
@@ -64,5 +74,8 @@ def check():
 if __name__ == "__main__":
     if sys.argv[1:] == ["--check"]:
         sys.exit(check())
-    print(json.dumps({name: fingerprint(simulate_case(name)) for name in CASES}, indent=1, sort_keys=True,
-                     default=str))
+    print(
+        json.dumps(
+            {name: fingerprint(simulate_case(name)) for name in CASES}, indent=1, sort_keys=True, default=str
+        )
+    )

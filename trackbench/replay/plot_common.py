@@ -37,7 +37,9 @@ def find_timeseries(path):
         if len(ncs) == 1:
             return ncs[0]
         if len(ncs) > 1:
-            raise FileNotFoundError(f"{path} holds several .nc files ({', '.join(p.name for p in ncs)}); give one")
+            raise FileNotFoundError(
+                f"{path} holds several .nc files ({', '.join(p.name for p in ncs)}); give one"
+            )
         raise FileNotFoundError(f"{path} holds no timeseries.nc (nor any .nc file)")
     raise FileNotFoundError(f"{path} does not exist")
 
@@ -50,9 +52,11 @@ def load_run(ds_or_path):
     path = find_timeseries(ds_or_path)
     try:
         ds = xr.load_dataset(path)
-    except (ValueError, OSError) as e:    # xarray's "did not find a match in any of ... IO backends"
-        raise ValueError(f"{path} is not a netCDF file trackbench can read ({type(e).__name__}); give a run's "
-                         ".nc file or its folder") from None
+    except (ValueError, OSError) as e:  # xarray's "did not find a match in any of ... IO backends"
+        raise ValueError(
+            f"{path} is not a netCDF file trackbench can read ({type(e).__name__}); give a run's "
+            ".nc file or its folder"
+        ) from None
     if "time" not in ds.dims or "scenario" not in ds.attrs:
         raise ValueError(f"{path} is a netCDF file but not a trackbench run (no time dimension or scenario)")
     return ds

@@ -8,8 +8,43 @@ track's drive, the soil's traction) and a study's (study_figures.py), sharing pl
 matplotlib is an optional dependency (extra "plot"); it is imported only when a figure is drawn.
 """
 
-from .plot_common import (PAPER_TIMES, SOIL_DENT, axis_label, find_timeseries, load_run, parameter_unit,  # noqa: F401
-                          run_label, value_label)
-from .run_figures import (_arrow_scale, choose_times, default_times, draw_configuration,  # noqa: F401
-                          plot_configuration, plot_run)
-from .study_figures import _groups, plot_study, remove_stale, study_axes  # noqa: F401
+from .plot_common import (
+    PAPER_TIMES,
+    SOIL_DENT,
+    axis_label,
+    find_timeseries,
+    load_run,
+    parameter_unit,
+    run_label,
+    value_label,
+)
+from .run_figures import (
+    _arrow_scale,
+    choose_times,
+    default_times,
+    draw_configuration,
+    plot_configuration,
+    plot_run,
+)
+from .study_figures import _groups, plot_study, remove_stale, study_axes
+
+__all__ = [
+    "PAPER_TIMES",
+    "SOIL_DENT",
+    "axis_label",
+    "find_timeseries",
+    "load_run",
+    "parameter_unit",
+    "run_label",
+    "value_label",
+    "_arrow_scale",
+    "choose_times",
+    "default_times",
+    "draw_configuration",
+    "plot_configuration",
+    "plot_run",
+    "_groups",
+    "plot_study",
+    "remove_stale",
+    "study_axes",
+]

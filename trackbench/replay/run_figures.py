@@ -7,8 +7,19 @@ import numpy as np
 
 from ..quantities import accounted_balance
 from . import geometry as G
-from .plot_common import (DPI, PAPER_TIMES, SOIL_DENT, _name, _plt, _status_note, _wheels_to_show, _wrap, load_run,
-                          run_label)
+from . import soil_view as S
+from .plot_common import (
+    DPI,
+    PAPER_TIMES,
+    SOIL_DENT,
+    _name,
+    _plt,
+    _status_note,
+    _wheels_to_show,
+    _wrap,
+    load_run,
+    run_label,
+)
 
 
 def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False, force_scale=G.FORCE_SCALE):
@@ -28,27 +39,44 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False, for
     ground = G.ground_polyline(ds, (x_range[0] - 1.0, x_range[1] + 1.0))
     y_floor = float(ground[:, 1].min()) - 0.4
     surface = ground
-    if G.is_soil(ds):
+    if S.is_soil(ds):
         # soft soil: the ground lowered by the rut made up to this frame (geometry.soil_surface);
         # the soil pressed out of the way (between the original surface and the dent) is pale
         # sand under a dashed line at the original surface
-        base, drop = G.soil_surface(ds, [i], (x_range[0] - 1.0, x_range[1] + 1.0))
+        base, drop = S.soil_surface(ds, [i], (x_range[0] - 1.0, x_range[1] + 1.0))
         surface = base - np.stack([np.zeros_like(drop[0]), drop[0]], axis=-1)
-        ax.fill_between(base[:, 0], base[:, 1], surface[:, 1], facecolor=SOIL_DENT, edgecolor="none", zorder=1.1)
+        ax.fill_between(
+            base[:, 0], base[:, 1], surface[:, 1], facecolor=SOIL_DENT, edgecolor="none", zorder=1.1
+        )
         ax.plot(ground[:, 0], ground[:, 1], color="#785528", lw=0.8, ls=(0, (4, 3)), zorder=1.2)
         y_floor = min(y_floor, float(surface[:, 1].min()) - 0.4)
-    ax.add_patch(Polygon(np.vstack([surface, [[surface[-1, 0], -50.0], [surface[0, 0], -50.0]]]),
-                         closed=True, facecolor="#d8c3a0", edgecolor="#785528", hatch="///", lw=1.2, zorder=1))
-    ax.add_patch(Polygon(g["chassis"][0][:-1], closed=True, facecolor="#e9edf2", edgecolor="#3c3c3c", lw=1.5, zorder=2))
+    ax.add_patch(
+        Polygon(
+            np.vstack([surface, [[surface[-1, 0], -50.0], [surface[0, 0], -50.0]]]),
+            closed=True,
+            facecolor="#d8c3a0",
+            edgecolor="#785528",
+            hatch="///",
+            lw=1.2,
+            zorder=1,
+        )
+    )
+    ax.add_patch(
+        Polygon(g["chassis"][0][:-1], closed=True, facecolor="#e9edf2", edgecolor="#3c3c3c", lw=1.5, zorder=2)
+    )
     for (px, py), (wx, wy) in zip(g["pivots"][0], wheels):
         ax.plot([px, wx], [py, wy], color="#6e6e6e", lw=3, zorder=3, solid_capstyle="round")
         ax.plot([px], [py], "o", color="#3c3c3c", ms=3, zorder=4)
     for k, (wx, wy) in enumerate(wheels):
         ax.add_patch(Circle((wx, wy), r, facecolor="#f4f4f4", edgecolor="#222222", lw=1.3, zorder=3))
-        ax.text(wx, wy + 0.02, str(int(ds["wheel"].values[k])), ha="center", va="center", fontsize=7, zorder=6)
+        ax.text(
+            wx, wy + 0.02, str(int(ds["wheel"].values[k])), ha="center", va="center", fontsize=7, zorder=6
+        )
     if G.is_closed(ds):
         _draw_closed_parts(ax, ds, g)
-    lc = LineCollection(g["links"][0], colors=G.tension_rgb(g["tension"][0]) / 255.0, linewidths=2.4, zorder=4)
+    lc = LineCollection(
+        g["links"][0], colors=G.tension_rgb(g["tension"][0]) / 255.0, linewidths=2.4, zorder=4
+    )
     ax.add_collection(lc)
     ax.plot(pins[:, 0], pins[:, 1], "o", color="#1e1e1e", ms=2.2, zorder=5)
     if arrows:
@@ -85,8 +113,11 @@ def _draw_closed_parts(ax, ds, g):
     ax.plot([axis[0], teeth[0, 0]], [axis[1], teeth[0, 1]], color="#283c6e", lw=1.0, zorder=3)
     ax.plot([axis[0]], [axis[1]], "o", color="#283c6e", ms=3, zorder=4)
     ix, iy = g["idler"][0]
-    ax.add_patch(Circle((ix, iy), float(lay["idler_radius"]), facecolor="#f4f4f4", edgecolor="#5a5a5a", lw=1.3,
-                        zorder=3))
+    ax.add_patch(
+        Circle(
+            (ix, iy), float(lay["idler_radius"]), facecolor="#f4f4f4", edgecolor="#5a5a5a", lw=1.3, zorder=3
+        )
+    )
     # the guide is shorter than the idler is wide: drawn over the idler's face so it shows
     guide = g["guide"][0]
     ax.plot(guide[:, 0], guide[:, 1], color="#b4783c", lw=5, solid_capstyle="butt", zorder=3.5)
@@ -105,11 +136,13 @@ def _arrow(ax, x, y, dx, dy, color, lw):
 
 
 def _tension_colorbar(fig, axes):
-    import matplotlib.colors as mcolors
     import matplotlib.cm as cm
+    import matplotlib.colors as mcolors
     stops = (G.TENSION_STOPS - G.TENSION_STOPS[0]) / (G.TENSION_STOPS[-1] - G.TENSION_STOPS[0])
     cmap = mcolors.LinearSegmentedColormap.from_list("tension", list(zip(stops, G.TENSION_RGB / 255.0)))
-    sm = cm.ScalarMappable(norm=mcolors.Normalize(G.TENSION_STOPS[0] / 1e3, G.TENSION_STOPS[-1] / 1e3), cmap=cmap)
+    sm = cm.ScalarMappable(
+        norm=mcolors.Normalize(G.TENSION_STOPS[0] / 1e3, G.TENSION_STOPS[-1] / 1e3), cmap=cmap
+    )
     cb = fig.colorbar(sm, ax=axes, fraction=0.025, pad=0.01)
     cb.set_label("link tension (kN), < 0 compression")
 
@@ -137,7 +170,7 @@ def choose_times(ds, times=None):
     out = [float(x) for x in times if float(x) not in inside]
     note = ""
     if out:
-        note = (f"; {', '.join(f'{x:g}' for x in out)} s left out: the run covers {t[0]:.3g} .. {t[-1]:.4g} s")
+        note = f"; {', '.join(f'{x:g}' for x in out)} s left out: the run covers {t[0]:.3g} .. {t[-1]:.4g} s"
     if not inside:
         inside = list(default_times(ds))
         note += ", times spread over it instead"
@@ -167,7 +200,9 @@ def plot_configuration(ds, times, path, label=None):
     t = np.asarray(ds["time"].values)
     chosen, note = choose_times(ds, times)
     idx = sorted({int(np.argmin(np.abs(t - x))) for x in chosen})
-    fig, axes = plt.subplots(len(idx), 1, figsize=(11, 3.3 * len(idx) + 0.9), squeeze=False, layout="constrained")
+    fig, axes = plt.subplots(
+        len(idx), 1, figsize=(11, 3.3 * len(idx) + 0.9), squeeze=False, layout="constrained"
+    )
     axes = axes[:, 0]
     # one x window wide enough for the vehicle at every chosen time, moved with the vehicle
     width = max(float(np.ptp(ds["pin_x"].values[i])) for i in idx) + 1.6
@@ -180,7 +215,7 @@ def plot_configuration(ds, times, path, label=None):
         draw_configuration(ax, ds, i, x_range=xr_, force_scale=scale)
     _tension_colorbar(fig, list(axes))
     soil = ("\nsoft soil: the rut made up to each time (pale sand) below the original surface (dashed)"
-            if G.is_soil(ds) else "")
+            if S.is_soil(ds) else "")
     parts = ("\nclosed track: sprocket with its teeth (blue, the line marks its turn), "
              "idler on its guide (bronze bar), support rollers" if G.is_closed(ds) else "")
     fig.suptitle(_wrap(f"{label or _name(ds)}: configuration (cf. Figs. 8-10){_status_note(ds)}{note}", 120)
@@ -237,18 +272,57 @@ def plot_run(ds_or_path, out_dir, times=None, label=None):
     paths = [plot_configuration(ds, times, out / "configuration.png", label=name)]
     wheels = _wheels_to_show(ds)
     fy = ds["wheel_force_y"]
-    paths.append(_time_plot(out / "wheel_force.png",
-                            f"{name}: vertical contact force between road wheel and track (cf. Figs. 11-14)",
-                            [(f"wheel {w}: F_y (kN)", [(fy.sel(wheel=w).values / 1e3, "", {"color": "C0", "lw": 0.9})])
-                             for w in wheels], ds))
-    paths.append(_time_plot(out / "chassis_ay.png", f"{name}: vertical acceleration of the chassis mass centre "
-                            "(cf. Figs. 15-16)",
-                            [("a_y (m/s$^2$)", [(ds["chassis_ay"].values, "", {"color": "C3", "lw": 0.8})])], ds))
-    paths.append(_time_plot(out / "chassis_vx.png", f"{name}: horizontal velocity of the chassis mass centre (cf. Fig. 17)",
-                            [("v_x (m/s)", [(ds["chassis_vx"].values, "", {"color": "C2", "lw": 1.0})])], ds))
-    e = [(ds[v].values / 1e3, label, {"lw": 1.0, "color": c}) for v, label, c in
-         (("energy_kinetic", "kinetic", "C0"), ("energy_elastic", "elastic (torsion bars, links, pads)", "C2"),
-          ("energy_gravity", "gravity potential (from t = 0)", "C1"), ("energy_balance", "balance (sum)", "k"))]
+    paths.append(
+        _time_plot(
+            out / "wheel_force.png",
+            f"{name}: vertical contact force between road wheel and track (cf. Figs. 11-14)",
+            [
+                (f"wheel {w}: F_y (kN)", [(fy.sel(wheel=w).values / 1e3, "", {"color": "C0", "lw": 0.9})])
+                for w in wheels
+            ],
+            ds,
+        )
+    )
+    paths.append(
+        _time_plot(
+            out / "chassis_ay.png",
+            f"{name}: vertical acceleration of the chassis mass centre (cf. Figs. 15-16)",
+            [("a_y (m/s$^2$)", [(ds["chassis_ay"].values, "", {"color": "C3", "lw": 0.8})])],
+            ds,
+        )
+    )
+    paths.append(
+        _time_plot(
+            out / "chassis_vx.png",
+            f"{name}: horizontal velocity of the chassis mass centre (cf. Fig. 17)",
+            [("v_x (m/s)", [(ds["chassis_vx"].values, "", {"color": "C2", "lw": 1.0})])],
+            ds,
+        )
+    )
+    paths.append(_plot_energy(ds, name, out / "energy.png"))
+    if G.is_closed(ds) and "sprocket_torque" in ds:
+        paths.append(_plot_drive(ds, name, out / "drive.png"))
+    if (
+        "sinkage" in ds
+        or "drawbar_pull" in ds
+        or ("drawbar_load" in ds and np.any(ds["drawbar_load"].values != 0))
+    ):
+        paths.append(_plot_traction(ds, name, out / "traction.png"))
+    return paths
+
+
+def _plot_energy(ds, name, path):
+    """The energies and the balance deviation (Fig. 18); with dampers, friction, soil or a
+    drive, what left on purpose and the balance that accounts for it."""
+    e = [
+        (ds[v].values / 1e3, label, {"lw": 1.0, "color": c})
+        for v, label, c in (
+            ("energy_kinetic", "kinetic", "C0"),
+            ("energy_elastic", "elastic (torsion bars, links, pads)", "C2"),
+            ("energy_gravity", "gravity potential (from t = 0)", "C1"),
+            ("energy_balance", "balance (sum)", "k"),
+        )
+    ]
     deviation = [(100 * ds["energy_balance_error"].values, "energy balance", {"color": "k", "lw": 0.9}),
                  (100 * ds["energy_residual"].values, "work-based residual", {"color": "C3", "lw": 0.9})]
     accounted = accounted_balance(ds)
@@ -256,19 +330,22 @@ def plot_run(ds_or_path, out_dir, times=None, label=None):
         # energy that left on purpose (dampers, friction, soil, drawbar) added back, the drive's taken out
         closed, label = accounted
         dissipated = ds["energy_dissipated"].values
-        e.append((dissipated / 1e3, "dissipated (dampers, friction, soil, drawbar)", {"color": "C5", "lw": 1.0}))
+        e.append(
+            (dissipated / 1e3, "dissipated (dampers, friction, soil, drawbar)", {"color": "C5", "lw": 1.0})
+        )
         if "drive_work" in ds:
             e.append((ds["drive_work"].values / 1e3, "drive work", {"color": "C6", "lw": 1.0}))
         e0 = float(ds.attrs["initial_total_energy"])
-        e.append(((ds["energy_balance"].values[0] + e0 * (closed - closed[0])) / 1e3, label, {"color": "C4", "lw": 1.0}))
+        e.append(
+            (
+                (ds["energy_balance"].values[0] + e0 * (closed - closed[0])) / 1e3,
+                label,
+                {"color": "C4", "lw": 1.0},
+            )
+        )
         deviation.append((100 * closed, label, {"color": "C4", "lw": 0.9}))
-    paths.append(_time_plot(out / "energy.png", f"{name}: energies (cf. Fig. 18)",
-                            [("energy (kJ)", e), ("balance deviation (% of E0)", deviation)], ds))
-    if G.is_closed(ds) and "sprocket_torque" in ds:
-        paths.append(_plot_drive(ds, name, out / "drive.png"))
-    if "sinkage" in ds or "drawbar_pull" in ds or ("drawbar_load" in ds and np.any(ds["drawbar_load"].values != 0)):
-        paths.append(_plot_traction(ds, name, out / "traction.png"))
-    return paths
+    return _time_plot(path, f"{name}: energies (cf. Fig. 18)",
+                      [("energy (kJ)", e), ("balance deviation (% of E0)", deviation)], ds)
 
 
 def _plot_drive(ds, name, path):
@@ -278,8 +355,10 @@ def _plot_drive(ds, name, path):
     speeds = [(ds["sprocket_speed"].values * rp, f"sprocket speed x pitch radius ({rp:.3f} m)",
                {"color": "C0", "lw": 1.0}),
               (ds["chassis_vx"].values, "chassis speed", {"color": "C2", "lw": 1.0})]
-    panels = [("sprocket torque (kN m)", [(ds["sprocket_torque"].values / 1e3, "", {"color": "C3", "lw": 0.9})]),
-              ("speed (m/s)", speeds)]
+    panels = [
+        ("sprocket torque (kN m)", [(ds["sprocket_torque"].values / 1e3, "", {"color": "C3", "lw": 0.9})]),
+        ("speed (m/s)", speeds),
+    ]
     if "idler_force" in ds:
         panels.append(("idler force (kN),\noutward positive", [(ds["idler_force"].values / 1e3, "",
                                                                {"color": "C4", "lw": 0.9})]))
@@ -295,12 +374,27 @@ def _plot_traction(ds, name, path):
         with np.errstate(divide="ignore", invalid="ignore"):
             slip = np.where(track != 0, 1.0 - ds["chassis_vx"].values / track, np.nan)
     if slip is not None:
-        panels.append(("slip at the sprocket (%)", [(100 * slip, "1 - chassis speed / (sprocket speed x pitch radius)",
-                                                     {"color": "C0", "lw": 0.9})]))
+        panels.append(
+            (
+                "slip at the sprocket (%)",
+                [
+                    (
+                        100 * slip,
+                        "1 - chassis speed / (sprocket speed x pitch radius)",
+                        {"color": "C0", "lw": 0.9},
+                    )
+                ],
+            )
+        )
     pull = []
     if "drawbar_pull" in ds:
-        pull.append((ds["drawbar_pull"].values / 1e3, "drawbar pull (ground's net horizontal force on the track)",
-                     {"color": "C1", "lw": 0.9}))
+        pull.append(
+            (
+                ds["drawbar_pull"].values / 1e3,
+                "drawbar pull (ground's net horizontal force on the track)",
+                {"color": "C1", "lw": 0.9},
+            )
+        )
     if "drawbar_load" in ds and np.any(ds["drawbar_load"].values != 0):
         pull.append((ds["drawbar_load"].values / 1e3, "drawbar load on the chassis (rearward positive)",
                      {"color": "C7", "lw": 0.9}))

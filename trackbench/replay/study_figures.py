@@ -8,8 +8,21 @@ import numpy as np
 
 from .plot_common import DPI, _parsed, _plt, _wrap, axis_label, display_scale, value_label
 
-BOOKKEEPING = {"run_id", "status", "status_message", "variant", "replicate", "steps", "rejected_steps", "t_final",
-               "wall_time", "solve_time", "recording", "recording_error", "seed"}
+BOOKKEEPING = {
+    "run_id",
+    "status",
+    "status_message",
+    "variant",
+    "replicate",
+    "steps",
+    "rejected_steps",
+    "t_final",
+    "wall_time",
+    "solve_time",
+    "recording",
+    "recording_error",
+    "seed",
+}
 
 
 def study_axes(df):
@@ -50,7 +63,14 @@ def _find_summary(study_dir):
 
 
 MAX_LINES = 6        # one line per value of the other axes up to this many, else the median
-_STYLES = [("-", "o"), ("--", "s"), (":", "^"), ("-.", "D"), ((0, (5, 1, 1, 1, 1, 1)), "v"), ((0, (1, 3)), "P")]
+_STYLES = [
+    ("-", "o"),
+    ("--", "s"),
+    (":", "^"),
+    ("-.", "D"),
+    ((0, (5, 1, 1, 1, 1, 1)), "v"),
+    ((0, (1, 3)), "P"),
+]
 
 
 def _manifest(src):
@@ -85,7 +105,12 @@ def _axis_column(df, axis, src):
 def _category_key(v):
     p = _parsed(v)
     if isinstance(p, dict):
-        return (str(p.get("kind", "")), float(p.get("height", 0.0) or 0.0), float(p.get("length", 0.0) or 0.0), "")
+        return (
+            str(p.get("kind", "")),
+            float(p.get("height", 0.0) or 0.0),
+            float(p.get("length", 0.0) or 0.0),
+            "",
+        )
     return ("", 0.0, 0.0, str(v))
 
 
@@ -96,10 +121,19 @@ def _groups(df, others, xs):
     import pandas as pd
     if not others:
         return [(None, np.ones(len(df), bool))], False
-    key = df[others].astype(object).where(df[others].notna(), None).apply(
-        lambda r: json.dumps([None if v is None else (v if isinstance(v, str) else float(v)) for v in r]), axis=1)
+    key = (
+        df[others]
+        .astype(object)
+        .where(df[others].notna(), None)
+        .apply(
+            lambda r: json.dumps([None if v is None else (v if isinstance(v, str) else float(v)) for v in r]),
+            axis=1,
+        )
+    )
     valid = np.isfinite(xs)
-    mixed = pd.Series(key[valid].to_numpy()).groupby(xs[valid]).nunique().gt(1).any() if valid.any() else False
+    mixed = (
+        pd.Series(key[valid].to_numpy()).groupby(xs[valid]).nunique().gt(1).any() if valid.any() else False
+    )
     combos = sorted(key[valid].unique(), key=lambda k: [_category_key(v) if isinstance(v, str) else
                                                          ("", -np.inf if v is None else v, 0.0, "")
                                                          for v in json.loads(k)])
@@ -110,7 +144,9 @@ def _groups(df, others, xs):
     out = []
     for k in combos:
         vals = json.loads(k)
-        label = ", ".join(f"{a} {value_label(a, v)}" for a, v in zip(others, vals) if v is not None) or "others"
+        label = (
+            ", ".join(f"{a} {value_label(a, v)}" for a, v in zip(others, vals) if v is not None) or "others"
+        )
         out.append((label, (key == k).to_numpy()))
     return out, False
 
@@ -134,12 +170,18 @@ def _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed):
     failed runs as red crosses on the axis."""
     for k, c in enumerate(cols):
         y = df[c].astype(float).to_numpy() / per_unit
-        label = f"wheel {_wheel_of(c)}" if _wheel_of(c) is not None else c.replace("peak_", "peak ").replace("_", " ")
+        label = (
+            f"wheel {_wheel_of(c)}"
+            if _wheel_of(c) is not None
+            else c.replace("peak_", "peak ").replace("_", " ")
+        )
         for gi, (glabel, mask) in enumerate(groups):
             ls, marker = _STYLES[gi % len(_STYLES)] if glabel else ("-", "o")
             m = mask & completed & np.isfinite(x_all)
             ax.plot(x_all[m], y[m], marker, ls="none", color=f"C{k}", ms=4, alpha=0.6)
-            med = np.array([np.nanmedian(y[m][x_all[m] == v]) if np.any(x_all[m] == v) else np.nan for v in order])
+            med = np.array(
+                [np.nanmedian(y[m][x_all[m] == v]) if np.any(x_all[m] == v) else np.nan for v in order]
+            )
             fin = np.isfinite(med)
             ax.plot(order[fin], med[fin], ls=ls, color=f"C{k}", lw=1.3, label=label if gi == 0 else None)
     bad = ~completed & np.isfinite(x_all)
@@ -157,8 +199,17 @@ def _legend(ax, groups, plt):
         return
     handles, labels = ax.get_legend_handles_labels()
     handles += [plt.Line2D([], [], ls="none")] + [
-        plt.Line2D([], [], color="k", ls=_STYLES[gi % len(_STYLES)][0], marker=_STYLES[gi % len(_STYLES)][1], ms=4,
-                   lw=1.1) for gi in range(len(groups))]
+        plt.Line2D(
+            [],
+            [],
+            color="k",
+            ls=_STYLES[gi % len(_STYLES)][0],
+            marker=_STYLES[gi % len(_STYLES)][1],
+            ms=4,
+            lw=1.1,
+        )
+        for gi in range(len(groups))
+    ]
     labels += ["line:"] + [_wrap(g[0], 34) for g in groups]
     ax.legend(handles, labels, fontsize=7.5, loc="upper left", bbox_to_anchor=(1.01, 1.0))
 
@@ -186,8 +237,14 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
     others = [a for a in present if a not in tied]
     groups, too_many = _groups(df, others, np.where(completed, x_all, np.nan))
     grouped = bool(groups[0][0])
-    fig, axs = plt.subplots(len(panels), 1, figsize=(10 if grouped else 8, (3.4 if len(panels) < 3 else 2.6) * len(panels) + 0.7),
-                            sharex=True, squeeze=False, layout="constrained")
+    fig, axs = plt.subplots(
+        len(panels),
+        1,
+        figsize=(10 if grouped else 8, (3.4 if len(panels) < 3 else 2.6) * len(panels) + 0.7),
+        sharex=True,
+        squeeze=False,
+        layout="constrained",
+    )
     for ax, (ylabel, cols, per_unit) in zip(axs[:, 0], panels):
         _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed)
         ax.set_ylabel(ylabel)
@@ -195,7 +252,9 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
     if not numeric:
         labels = [value_label(axis, v) for v in raw]
         tilt = max(map(len, labels), default=0) > 12 or len(labels) > 6
-        axs[-1, 0].set_xticks(range(len(raw)), labels, rotation=25 if tilt else 0, ha="right" if tilt else "center")
+        axs[-1, 0].set_xticks(
+            range(len(raw)), labels, rotation=25 if tilt else 0, ha="right" if tilt else "center"
+        )
     axs[-1, 0].set_xlabel(axis_label(axis, col.dropna().to_numpy() if numeric else ()))
     note = _note(axis, others, tied, grouped, too_many, np.isfinite(x_all).sum() > len(order))
     what = _what(panels)
@@ -206,8 +265,12 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
 
 # the panels beyond the forces, each alone in its own unit: what the title calls them, and the
 # y label where the quantity's own label is too long for the panel's height (None: its own)
-_OWN_PANELS = {"peak_sprocket_torque": ("sprocket torque", "peak sprocket torque"), "peak_sinkage": ("sinkage", None),
-               "mean_drawbar_pull": ("drawbar pull", None), "mean_slip": ("slip", None)}
+_OWN_PANELS = {
+    "peak_sprocket_torque": ("sprocket torque", "peak sprocket torque"),
+    "peak_sinkage": ("sinkage", None),
+    "mean_drawbar_pull": ("drawbar pull", None),
+    "mean_slip": ("slip", None),
+}
 
 
 def _what(panels):
@@ -223,7 +286,12 @@ def _panels(df):
     sprocket torque, the deepest sinkage, the mean drawbar pull and the mean slip), each alone
     (their own units)."""
     from ..quantities import BY_NAME, PEAKS
-    forces = [q.name for q in PEAKS if q.unit == "kN" and q.kind == "peak" and not q.per_wheel and q.name in df.columns]
+
+    forces = [
+        q.name
+        for q in PEAKS
+        if q.unit == "kN" and q.kind == "peak" and not q.per_wheel and q.name in df.columns
+    ]
     panels = [("peak vertical wheel-track force (kN)", _wheel_columns(df), 1e3)]
     if forces:
         panels.append(("peak force (kN)", forces, 1e3))
@@ -343,15 +411,28 @@ def _plot_drawbar_pull(src, ok, out, has_drawbar=False):
                 ax.plot(xw, w / 1e3, "s--", color=f"C{k}", ms=4, lw=1, mfc="none",
                         label=f"{name}: Wong's thrust at the soil's slip (uniform pressure)")
         if free:
-            ax.plot(100 * np.array([p["track_slip"] for p in free]), [p["pull"] / 1e3 for p in free], "o",
-                    color=f"C{k}", mfc="none", ms=6, ls="none", label=f"{name}: free-running runs (no drawbar)")
+            ax.plot(
+                100 * np.array([p["track_slip"] for p in free]),
+                [p["pull"] / 1e3 for p in free],
+                "o",
+                color=f"C{k}",
+                mfc="none",
+                ms=6,
+                ls="none",
+                label=f"{name}: free-running runs (no drawbar)",
+            )
     ax.set_xlabel("slip the soil sees (%): 1 - chassis speed / the track's speed in the contact")
     ax.set_ylabel("drawbar pull (kN)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
-    ax.set_title(_wrap(f"study {_study_name(src)}: drawbar pull against the soil's slip (means over each run's "
-                       "second half); the numbers at the points: the slip at the sprocket the towing rig held", 90),
-                 fontsize=10)
+    ax.set_title(
+        _wrap(
+            f"study {_study_name(src)}: drawbar pull against the soil's slip (means over each run's "
+            "second half); the numbers at the points: the slip at the sprocket the towing rig held",
+            90,
+        ),
+        fontsize=10,
+    )
     path = out / "study_drawbar_pull.png"
     fig.savefig(path, dpi=DPI)
     plt.close(fig)

@@ -49,6 +49,7 @@ def _from_netcdf(nc):
     rrd = nc.parent / (RECORDING_NAME if nc.name == "timeseries.nc" else nc.stem + ".rrd")
     if not rrd.exists() or rrd.stat().st_mtime < nc.stat().st_mtime:
         import xarray as xr
+
         from .record import write_recording
         write_recording(xr.load_dataset(nc), rrd)
         print(f"wrote {rrd} from {nc}", file=sys.stderr)

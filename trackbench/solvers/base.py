@@ -1,12 +1,38 @@
-"""What every solver takes and returns: the step-control settings, the output arrays it
-fills, and the result it hands to output.py."""
+"""What every time integrator takes and returns, and what it must do (its contract, as
+scipy's OdeSolver documents its own). solvers/registry.py names the integrators.
+
+A solver is a module with ``run(scenario, model, y0) -> RunResult`` that:
+
+1. integrates the model (assembly.Model: the compiled arrays of one run) from the reduced
+   state y0 = (q, qd, W) at t = 0 to ``scenario["duration"]``, with its settings from the
+   validated scenario only (``control(scenario)``: tolerance, output interval, step limits;
+   ``method``); it validates nothing itself;
+2. may integrate in coordinates of its own, but takes and returns the reduced layout
+   (model/core/indices.py): every output means the same whichever solver made it;
+3. controls its step by an error estimate and never steps over a contact switch: an onset
+   or release inside a rejected step is located (solvers/common/events.py) and the retry
+   ends just after it;
+4. fills ``Outputs`` (``allocate_outputs``): samples at t_k = k output_interval from its
+   dense output between accepted steps, the peaks over every accepted step
+   (solvers/common/monitor.py update_peaks, so no impulse between samples is missed), the
+   statistics (indices.S_*: steps, rejected steps, right-hand sides, status, t_final);
+5. moves the ground's memories (soil sinkage, bristle anchors, approach speeds) only after
+   an accepted step, never inside one (a rejected step leaves no trace);
+6. stops at the first failure with a status code (status.Result: NaN, step-size underflow,
+   a wheel through the track, max steps), keeping the samples up to there; compiled code
+   never raises;
+7. is reproducible to the last bit: no fastmath, no threads, the elementary functions of
+   model/core/fixed_math (docs/development.md, "Bit for bit");
+8. returns ``trimmed(scenario, out, extra)``; figures of its own go to RunResult.extra and
+   are named in results_schema.md.
+"""
 
 from collections import namedtuple
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..model import layout as L
+from ..model.core import indices as L
 
 H0 = 1e-5        # s: first trial step; the controller grows it at once
 H_MIN = 1e-13    # s: below this the run stops with STEP_SIZE_UNDERFLOW

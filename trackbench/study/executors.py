@@ -97,7 +97,10 @@ def folder_problem(output):
         return (f"the folder {output} on worker host {host} is not the study's (no runs.json): every worker "
                 "must see the study folder at the same path (a shared file system)")
     if not os.access(output, os.W_OK | os.X_OK):
-        return f"permission denied: worker host {host} (uid {os.getuid()}) cannot write to the study folder {output}"
+        return (
+            f"permission denied: worker host {host} (uid {os.getuid()}) cannot write to the study "
+            f"folder {output}"
+        )
     return None
 
 
@@ -150,9 +153,9 @@ def _simulate(task, rec):
     """The run's Dataset, or None (``rec`` failed) when the scenario or the solver raised."""
     try:
         from .. import __version__
-        from ..version import MODEL_VERSION
         from ..scenario import Scenario
         from ..simulate import simulate
+        from ..version import MODEL_VERSION
         rec.update(model_version=MODEL_VERSION, trackbench_version=__version__)
         return simulate(Scenario.from_dict({}, base=task["scenario"]))
     except Exception as e:
@@ -196,7 +199,11 @@ def _write(ds, rdir, task, rec):
         _fail(rec, exc, rdir, need_bytes=ds.nbytes)
         return
     a = ds.attrs
-    msg = a["status_message"] if a["status"] == "completed" else f"{a['status_message']} at t = {a['t_final']:.6g} s"
+    msg = (
+        a["status_message"]
+        if a["status"] == "completed"
+        else f"{a['status_message']} at t = {a['t_final']:.6g} s"
+    )
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
                timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording)
@@ -423,4 +430,6 @@ def check_executor(executor, scheduler):
         try:
             import dask.distributed  # noqa: F401
         except ImportError:
-            raise ValueError("--executor dask needs dask.distributed: pip install 'trackbench[dask]'") from None
+            raise ValueError(
+                "--executor dask needs dask.distributed: pip install 'trackbench[dask]'"
+            ) from None

@@ -77,7 +77,11 @@ def _kinds():
     kinds = spec.get("scenarios") or [None]
     for d in kinds:
         try:
-            sc = trackbench.Scenario.paper(**short) if d is None else trackbench.Scenario.from_dict({**d, **short})
+            sc = (
+                trackbench.Scenario.paper(**short)
+                if d is None
+                else trackbench.Scenario.from_dict({**d, **short})
+            )
         except Exception:  # noqa: BLE001  (the real run reports it)
             continue
         yield sc, spec.get("flag")
@@ -113,8 +117,13 @@ def warm_recording():
 def facts():
     """What a worker inherited (for tests and diagnosis): its pid, the fork server's thread
     count at the end of the preload, and how many compiled signatures the time loop has."""
-    from trackbench.solvers.reduced import integrate
-    return {"pid": os.getpid(), "threads_at_fork": THREADS_AT_FORK, "loop_signatures": len(integrate.signatures)}
+    from trackbench.solvers.rk.rk_loop import integrate
+
+    return {
+        "pid": os.getpid(),
+        "threads_at_fork": THREADS_AT_FORK,
+        "loop_signatures": len(integrate.signatures),
+    }
 
 
 try:

@@ -60,10 +60,25 @@ def manifest(study):
     """runs.json: the study's runs as expanded now, so the folder can be read later even when
     the package's defaults (and so a re-expansion's run ids) have changed; ``source`` is the
     study file (absolute), which the folder belongs to (check_output)."""
-    return {"name": study.name, "source": os.path.abspath(study.source), "description": study.description, "replicates": study.replicates,
-            "storage": study.storage, "param_names": study.param_names,
-            "runs": [{"run_id": r.run_id, "index": r.index, "variant": r.variant, "replicate": r.replicate,
-                      "params": r.params, "scenario": r.scenario} for r in study.runs]}
+    return {
+        "name": study.name,
+        "source": os.path.abspath(study.source),
+        "description": study.description,
+        "replicates": study.replicates,
+        "storage": study.storage,
+        "param_names": study.param_names,
+        "runs": [
+            {
+                "run_id": r.run_id,
+                "index": r.index,
+                "variant": r.variant,
+                "replicate": r.replicate,
+                "params": r.params,
+                "scenario": r.scenario,
+            }
+            for r in study.runs
+        ],
+    }
 
 
 def recorded_source(output):
@@ -106,9 +121,11 @@ def check_output(study):
     owner, exact = rec
     same = _same_file(owner, study.source) if exact else Path(owner).name == Path(study.source).name
     if not same:
-        raise StudyError(f"{study.output} holds the results of another study file, {owner}; running "
-                         f"{study.source} there would replace them: give {study.source} another [study] name (or "
-                         f"output), or run it with --output FOLDER")
+        raise StudyError(
+            f"{study.output} holds the results of another study file, {owner}; running "
+            f"{study.source} there would replace them: give {study.source} another [study] name (or "
+            f"output), or run it with --output FOLDER"
+        )
 
 
 def plan(study, force=False):
@@ -138,8 +155,16 @@ class _Progress:
         self.bar = None
         if not quiet and self.console.is_terminal and total:
             from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
-            self.bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), _counts_column(self),
-                                TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(), console=self.console)
+
+            self.bar = Progress(
+                TextColumn("[bold]{task.description}"),
+                BarColumn(),
+                _counts_column(self),
+                TimeElapsedColumn(),
+                TextColumn("ETA"),
+                TimeRemainingColumn(),
+                console=self.console,
+            )
             self.task = self.bar.add_task("runs", total=total, counts=self._counts())
             self.bar.start()
         elif not quiet:
@@ -179,9 +204,14 @@ class _Progress:
             n = self.done + self.failed
             _, compiled = self.compiling()
             if n == 1 and compiled > 0.0:
-                self.console.print(f"(the workers waited {compiled:.0f} s for the model to compile: once per "
-                                   "machine and version; later studies load it from the cache)", highlight=False)
-            el = max(time.perf_counter() - self.t0 - compiled, 0.0)   # the compiling is not what every run takes
+                self.console.print(
+                    f"(the workers waited {compiled:.0f} s for the model to compile: once per "
+                    "machine and version; later studies load it from the cache)",
+                    highlight=False,
+                )
+            el = max(
+                time.perf_counter() - self.t0 - compiled, 0.0
+            )  # the compiling is not what every run takes
             eta = el / n * (self.total - n)
             msg = "" if rec["status"] == "completed" else f": {rec.get('status_message', '')}"
             self.console.print(f"[{n}/{self.total}] {rec['run_id']} {rec['status']}{msg}  ({self._counts()}, "
@@ -226,8 +256,10 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         tasks, done = plan(study, force)
-        if tasks:   # they load while this process sets up
-            executors.start_workers(executor, scheduler, warm=warming.warm_kinds(t["scenario"] for t in tasks))
+        if tasks:  # they load while this process sets up
+            executors.start_workers(
+                executor, scheduler, warm=warming.warm_kinds(t["scenario"] for t in tasks)
+            )
         out.skipped = len(done)
         progress = _Progress(len(tasks), len(done), quiet, workers=workers, flag=warming.compile_flag())
         if executor == "dask":
@@ -282,7 +314,9 @@ def confirm(task, rec):
     already on disk as the worker's own record is written to run.json here."""
     rdir = store.run_dir(task["output"], task["run_id"])
     disk = store.read_json(rdir / "run.json")
-    own = disk is not None and rec.get("attempt_id") is not None and disk.get("attempt_id") == rec["attempt_id"]
+    own = (
+        disk is not None and rec.get("attempt_id") is not None and disk.get("attempt_id") == rec["attempt_id"]
+    )
     if rec["status"] == "completed":
         reason = _files_problem(rdir, disk, own, rec)
         if reason is None:
@@ -355,8 +389,11 @@ def report(outcome):
     text = format_table(outcome.summary, outcome.replicates, s.param_names)
     n_failed, n_missing = outcome.counts()
     missing = f", {n_missing} not run" if n_missing else ""
-    text += (f"\n\nstudy {s.name}: {count(len(s.runs), 'run')}, {outcome.ran} run now, {outcome.skipped} already completed, "
-             f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv")
+    text += (
+        f"\n\nstudy {s.name}: {count(len(s.runs), 'run')}, {outcome.ran} run now, {outcome.skipped} "
+        "already completed, "
+        f"{n_failed} failed{missing}; {outcome.elapsed:.1f} s\nresults: {s.output}/summary.csv"
+    )
     if outcome.summary_error:
         text += f" NOT WRITTEN: {outcome.summary_error}"
     if outcome.others:

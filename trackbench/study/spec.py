@@ -84,8 +84,10 @@ def expand_range(where, spec):
         if k not in RANGE_KEYS:
             raise _unknown(where, k, list(RANGE_KEYS))
     if "start" not in spec or "stop" not in spec or ("step" in spec) == ("num" in spec):
-        raise StudyError(f"{where}: a range needs start, stop and one of step or num, "
-                         f"e.g. {{start = 5.0, stop = 15.0, step = 2.5}} or {{start = 5.0, stop = 15.0, num = 5}}")
+        raise StudyError(
+            f"{where}: a range needs start, stop and one of step or num, "
+            f"e.g. {{start = 5.0, stop = 15.0, step = 2.5}} or {{start = 5.0, stop = 15.0, num = 5}}"
+        )
     start, stop = spec["start"], spec["stop"]
     if not (_is_number(start) and _is_number(stop) and math.isfinite(start) and math.isfinite(stop)):
         raise StudyError(f"{where}: start and stop must be finite numbers")
@@ -267,7 +269,9 @@ def load_study(path, output=None):
         raise StudyError(f"{path}: [study] description must be a text")
     reps = meta.get("replicates", 1)
     if not isinstance(reps, int) or isinstance(reps, bool) or not 1 <= reps <= 1000:
-        raise StudyError(f"{path}: [study] replicates = {reps!r} is not allowed: expected an integer in [1, 1000]")
+        raise StudyError(
+            f"{path}: [study] replicates = {reps!r} is not allowed: expected an integer in [1, 1000]"
+        )
     out = meta.get("output", f"results/{name}")
     if not isinstance(out, str) or not out:
         raise StudyError(f"{path}: [study] output must be a folder path (text)")
@@ -307,8 +311,10 @@ def load_study(path, output=None):
             rid = run_id(d)
             if rid in seen:
                 a = seen[rid]
-                raise StudyError(f"{path}: duplicate runs: run {a.variant + 1} and run {vi + 1} resolve to the "
-                                 f"same scenario ({', '.join(f'{k} = {x}' for k, x in params.items()) or 'base'})")
+                raise StudyError(
+                    f"{path}: duplicate runs: run {a.variant + 1} and run {vi + 1} resolve to the "
+                    f"same scenario ({', '.join(f'{k} = {x}' for k, x in params.items()) or 'base'})"
+                )
             run = Run(run_id=rid, index=len(study.runs), variant=vi, replicate=r, params=params, scenario=d)
             seen[rid] = run
             study.runs.append(run)
@@ -349,9 +355,17 @@ def _toml_key(k):
 
 def resolved_toml(study):
     """The resolved copy of the study: full base scenario, ranges expanded."""
-    lines = [f"# resolved copy of {study.source}: {len(study.runs)} runs", "",
-             "[study]", f"name = {_toml_value(study.name)}", f"description = {_toml_value(study.description)}",
-             f"replicates = {study.replicates}", f"storage = {_toml_value(study.storage)}", "", "[scenario]"]
+    lines = [
+        f"# resolved copy of {study.source}: {len(study.runs)} runs",
+        "",
+        "[study]",
+        f"name = {_toml_value(study.name)}",
+        f"description = {_toml_value(study.description)}",
+        f"replicates = {study.replicates}",
+        f"storage = {_toml_value(study.storage)}",
+        "",
+        "[scenario]",
+    ]
     tables = []
     for k, v in study.base.items():
         if k == "name":

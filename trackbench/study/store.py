@@ -21,7 +21,6 @@ from pathlib import Path
 from ..atomic import TMP_SUFFIX, atomic_path, tmp_path  # noqa: F401  (tmp_path: the workers' and clean_tmp's)
 
 
-
 class StudyLocked(RuntimeError):
     """Another process holds the study folder's lock."""
 
@@ -94,7 +93,9 @@ def is_completed(output, rid):
 def clean_tmp(output):
     """Remove temporary files a killed run left behind; returns how many."""
     n = 0
-    for p in list(Path(output).glob(".*" + TMP_SUFFIX + "*")) + list(Path(output).glob("runs/*/.*" + TMP_SUFFIX + "*")):
+    for p in list(Path(output).glob(".*" + TMP_SUFFIX + "*")) + list(
+        Path(output).glob("runs/*/.*" + TMP_SUFFIX + "*")
+    ):
         try:
             p.unlink()
             n += 1

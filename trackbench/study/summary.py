@@ -13,9 +13,20 @@ from .spec import Run, Study, StudyError, load_study
 
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
 # the results in the study table on screen, in its column order (vertical acceleration as min, max)
-SCREEN = ("peak_wheel_force_y", "peak_ground_force_y", "peak_link_tension", "min_chassis_ay", "peak_chassis_ay",
-          "min_chassis_vx", "first_compression_time", "peak_sprocket_torque", "peak_idler_force", "peak_sinkage",
-          "mean_drawbar_pull", "mean_slip")
+SCREEN = (
+    "peak_wheel_force_y",
+    "peak_ground_force_y",
+    "peak_link_tension",
+    "min_chassis_ay",
+    "peak_chassis_ay",
+    "min_chassis_vx",
+    "first_compression_time",
+    "peak_sprocket_torque",
+    "peak_idler_force",
+    "peak_sinkage",
+    "mean_drawbar_pull",
+    "mean_slip",
+)
 
 
 def _wheels(study):
@@ -186,7 +197,9 @@ def open_study(path, run=None):
     return summary_frame(_study_of(path))
 
 
-_STACK = dict(join="outer", data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts")
+_STACK = dict(
+    join="outer", data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts"
+)
 
 
 def _have_dask():
@@ -207,7 +220,6 @@ def open_study_dataset(path, status=("completed", "failed")):
     xarray.open_mfdataset where dask is installed, else read into memory; runs of different
     durations are aligned on time (NaN-padded). The study's parameters and each run's status
     become coordinates along ``run``."""
-    import xarray as xr
     study = _study_of(path)
     df = summary_frame(study)
     df = df[df.status.isin(status)]

@@ -1,0 +1,133 @@
+"""Candidate lists that keep the contact search away from far-apart pairs: for each wheel
+centre and ground corner, the links and pins within reach, rebuilt when something has
+moved more than the skin."""
+
+from numba import njit
+
+from ..core.indices import (
+    C_REBUILDS,
+    G_REACH,
+    K_CORNER_LINK,
+    K_CORNER_PIN,
+    K_GUIDE_LINK,
+    K_GUIDE_PIN,
+    K_PIN_GROUND,
+    K_WHEEL_LINK,
+    K_WHEEL_PIN,
+    NB_COUNT,
+    P_PAD_GROUND,
+    P_PAD_WHEEL,
+    P_SKIN,
+    P_WHEEL_RADIUS,
+    PN_LAST,
+    SEG_LENGTH,
+)
+from ..core.jit import BORROW, INLINE
+from .gaps import segment_coords
+
+
+@njit(**INLINE)
+def _seg_dist2(px, py, ax, ay, bx, by):
+    """Squared distance from point P to segment AB."""
+    ex = bx - ax
+    ey = by - ay
+    l2 = ex * ex + ey * ey
+    u = 0.0
+    if l2 > 0.0:
+        u = ((px - ax) * ex + (py - ay) * ey) / l2
+        u = min(1.0, max(0.0, u))
+    dx = px - ax - u * ex
+    dy = py - ay - u * ey
+    return dx * dx + dy * dy
+
+
+@njit(**INLINE)
+def _near_links(px, py, apos, reach, nbr, row):
+    """Candidate row: every link whose centre line passes within reach of P."""
+    n = 0
+    for b in range(apos.shape[0] - 1):
+        if _seg_dist2(px, py, apos[b, 0], apos[b, 1], apos[b + 1, 0], apos[b + 1, 1]) < reach * reach:
+            n += 1
+            nbr[row, n] = b
+    nbr[row, NB_COUNT] = n
+
+
+@njit(**INLINE)
+def _near_pins(px, py, apos, last, reach, nbr, row):
+    """Candidate row: every free pin (rows 1..last) within reach of P."""
+    n = 0
+    for b in range(1, last + 1):
+        dx = apos[b, 0] - px
+        dy = apos[b, 1] - py
+        if dx * dx + dy * dy < reach * reach:
+            n += 1
+            nbr[row, n] = b
+    nbr[row, NB_COUNT] = n
+
+
+@njit(**BORROW)
+def build_neighbours(apos, wc, gc, m):
+    """Fill the candidate lists: every pair that could touch while no pin, wheel, idler or
+    roller (gc) moves more than half the skin from where it is now."""
+    par, seg, corners, nbr, rows = m.par, m.seg, m.corners, m.nbr, m.nbr_rows
+    last = m.pins[PN_LAST]
+    skin = par[P_SKIN]
+    hg = par[P_PAD_GROUND]
+    reach_w = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL] + skin
+    reach_cl = max(hg, par[P_PAD_WHEEL]) + skin
+    for i in range(wc.shape[0]):
+        _near_links(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_LINK] + i)
+        _near_pins(wc[i, 0], wc[i, 1], apos, last, reach_w, nbr, rows[K_WHEEL_PIN] + i)
+    for j in range(gc.shape[0]):
+        reach_g = m.guides[j, G_REACH] + skin
+        _near_links(gc[j, 0], gc[j, 1], apos, reach_g, nbr, rows[K_GUIDE_LINK] + j)
+        _near_pins(gc[j, 0], gc[j, 1], apos, last, reach_g, nbr, rows[K_GUIDE_PIN] + j)
+    for c in range(corners.shape[0]):
+        _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
+        _near_pins(corners[c, 0], corners[c, 1], apos, last, hg + skin, nbr, rows[K_CORNER_PIN] + c)
+    for b in range(1, last + 1):
+        row = rows[K_PIN_GROUND] + b
+        n = 0
+        for j in range(seg.shape[0]):
+            lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, j)
+            if lam > -skin and lam < seg[j, SEG_LENGTH] + skin and s < hg + skin:
+                n += 1
+                nbr[row, n] = j
+        nbr[row, NB_COUNT] = n
+
+
+@njit(**INLINE)
+def refresh_neighbours(apos, wc, gc, m):
+    """Rebuild the lists if any pin, wheel, idler or roller moved more than skin/2 since the
+    last build (so the lists always hold every pair that can touch: results equal a full
+    search). gc: the idler and roller centres (no rows in the paper's layout)."""
+    ref = m.ref
+    half = 0.5 * m.par[P_SKIN]
+    lim = half * half
+    n_pins = apos.shape[0]
+    stale = False
+    for b in range(n_pins):
+        dx = apos[b, 0] - ref[b, 0]
+        dy = apos[b, 1] - ref[b, 1]
+        stale |= not (dx * dx + dy * dy <= lim)  # no early exit: the loop vectorises
+    for i in range(wc.shape[0]):
+        dx = wc[i, 0] - ref[n_pins + i, 0]
+        dy = wc[i, 1] - ref[n_pins + i, 1]
+        stale |= not (dx * dx + dy * dy <= lim)
+    n_wc = n_pins + wc.shape[0]
+    for j in range(gc.shape[0]):
+        dx = gc[j, 0] - ref[n_wc + j, 0]
+        dy = gc[j, 1] - ref[n_wc + j, 1]
+        stale |= not (dx * dx + dy * dy <= lim)
+    if stale:
+        build_neighbours(apos, wc, gc, m)
+        for b in range(n_pins):
+            ref[b, 0] = apos[b, 0]
+            ref[b, 1] = apos[b, 1]
+        for i in range(wc.shape[0]):
+            ref[n_pins + i, 0] = wc[i, 0]
+            ref[n_pins + i, 1] = wc[i, 1]
+        for j in range(gc.shape[0]):
+            ref[n_wc + j, 0] = gc[j, 0]
+            ref[n_wc + j, 1] = gc[j, 1]
+        m.counters[C_REBUILDS] += 1

@@ -1,0 +1,251 @@
+"""The static equilibrium's equations on flat ground (docs/model.md, "Initial equilibrium"):
+the residual of the force balance and its Jacobian, for either track layout; the numerical
+methods are solvers/equilibrium/.
+
+Every arm is held at the equilibrium arm angle; unknowns are the chassis height and
+pitch and the free pins. The torsion-bar free angles phi0_i (the preloads) follow from
+each arm's moment balance about its pivot, so they are eliminated from the Newton
+iteration and computed afterwards.
+"""
+
+
+import numpy as np
+from numba import njit
+
+from ..core import fixed_math as fm
+from ..core import indices as L
+from ..core.bundles import arm_table, model_arrays, work_arrays
+from ..core.indices_jit import n_coordinates, n_state, pin_offset, q_idler, q_sprocket
+from ..core.jit import KERNEL
+from ..ground.terrain import flat_ground
+from ..vehicle.parameters import equilibrium_arm_angle, pack, total_mass
+from .closed_track_jit import loop_rhs
+from .rhs import rhs
+
+
+class StaticProblem:
+    """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins)."""
+
+    def __init__(self, vehicle, track, gravity, contact=None, soil=None):
+        self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
+        for k, v in (soil or {}).items():    # soft soil: fresh (no memory cells), every pin loading
+            self.par[k] = v
+        self.nw = int(vehicle["n_wheels"])
+        self.n_links = int(track["n_links"])
+        self.phi = equilibrium_arm_angle(vehicle)
+        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
+        g = flat_ground()
+        self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links,
+                              rut=np.zeros(0) if soil else None)
+        self.work = work_arrays(self.m, self.nw, self.n_links)
+        self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
+        self.nq = L.n_coordinates(self.nw, self.n_links)
+        self.weight = total_mass(vehicle, track) * gravity
+
+    def q_of(self, u):
+        q = np.zeros(self.nq)
+        q[L.Q_Y] = u[0]
+        q[L.Q_PITCH] = u[1]
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
+        q[L.pin_offset(self.nw):] = u[2:]
+        return q
+
+    def _args(self):
+        return self.phi, self.m, self.work, self.diag
+
+    def residual(self, u):
+        """(vertical force, moment of chassis + arms, pin forces); horizontal force; arm moments."""
+        r = np.empty(u.size)
+        arm_moment = np.empty(self.nw)
+        fx = _residual(u, *self._args(), r, arm_moment)
+        return r, fx, arm_moment
+
+    def jacobian(self, u, h=1e-7):
+        """Central finite differences of the residual (a Python loop over compiled
+        residuals: 2 x 60 calls cost less than compiling the loop)."""
+        args = self._args()
+        rp = np.empty(u.size)
+        rm = np.empty(u.size)
+        am = np.empty(self.nw)
+        J = np.empty((u.size, u.size))
+        up = u.copy()
+        for k in range(u.size):
+            up[k] = u[k] + h
+            _residual(up, *args, rp, am)
+            up[k] = u[k] - h
+            _residual(up, *args, rm, am)
+            up[k] = u[k]
+            J[:, k] = (rp - rm) / (2.0 * h)
+        return J
+
+    def loads(self, q):
+        _loads_at_rest(q, self.m, self.work, self.diag)
+        return self.work.apos, self.work.fpin, self.work.fwheel, self.work.wc
+
+
+@njit(**KERNEL)
+def _loads_at_rest(q, m, w, diag):
+    """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
+    The solver's own right-hand side computes them: one compiled copy of the contact code."""
+    nq = q.shape[0]
+    y = np.zeros(n_state(nq))
+    for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
+        y[k] = q[k]
+    ydot = np.empty(n_state(nq))
+    rhs(y, m, w, ydot, diag)
+
+
+@njit(**KERNEL)
+def _residual(u, phi, m, w, diag, r, arm_moment):
+    """Force balance of every free pin, vertical force and moment of chassis + arms
+    (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
+    apos, fpin, fwheel, wc = w.apos, w.fpin, w.fwheel, w.wc
+    par, arms = m.par, m.arms
+    nw = arms.shape[0]
+    n = apos.shape[0] - 1
+    nq = n_coordinates(nw, n)
+    q = np.zeros(nq)
+    q[L.Q_Y] = u[0]
+    q[L.Q_PITCH] = u[1]
+    for i in range(nw):
+        q[L.Q_ARM + i] = phi  # every arm at the same equilibrium angle
+    for k in range(2, u.shape[0]):
+        q[L.Q_ARM + nw + k - 2] = u[k]
+    _loads_at_rest(q, m, w, diag)
+    s, c = fm.sincos(u[1])
+    g = par[L.P_GRAVITY]
+    ma = par[L.P_ARM_MASS]
+    yc = u[0]
+    fy = fpin[0, 1] + fpin[n, 1] - (par[L.P_CHASSIS_MASS] + nw * ma) * g
+    fx = fpin[0, 0] + fpin[n, 0]
+    mom = 0.0
+    for b in (0, n):
+        mom += apos[b, 0] * fpin[b, 1] - (apos[b, 1] - yc) * fpin[b, 0]
+    for i in range(nw):
+        wfy = fwheel[i, 1] - ma * g
+        fy += fwheel[i, 1]
+        fx += fwheel[i, 0]
+        mom += wc[i, 0] * wfy - (wc[i, 1] - yc) * fwheel[i, 0]
+        px = c * arms[i, 0] - s * arms[i, 1]
+        py = yc + s * arms[i, 0] + c * arms[i, 1]
+        arm_moment[i] = (wc[i, 0] - px) * wfy - (wc[i, 1] - py) * fwheel[i, 0]
+    r[0] = fy
+    r[1] = mom
+    for b in range(1, n):
+        r[2 * b] = fpin[b, 0]
+        r[2 * b + 1] = fpin[b, 1] - par[L.P_PIN_MASS] * g
+    return fx
+
+
+# --- the closed layout ---------------------------------------------------------------
+
+
+class ClosedStaticProblem(StaticProblem):
+    """The closed layout at rest: unknowns u = (y_c, pitch, idler slide, sprocket angle,
+    every pin), the arms at the equilibrium angle, the sprocket held by the drive at the
+    angle that seats the pins (where a free sprocket's teeth torque would vanish, Newton's
+    method does not find reliably: the loop's cogging energy is not smooth)."""
+
+    def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides, soil=None):
+        from ..vehicle.closed_track import loop_pins
+        self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
+        for k, v in (soil or {}).items():
+            self.par[k] = v
+        self.nw = int(vehicle["n_wheels"])
+        self.n_links = geometry.n_links
+        self.phi = equilibrium_arm_angle(vehicle)
+        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
+        g = flat_ground()
+        self.m = model_arrays(
+            self.par,
+            self.arms,
+            self.ends,
+            g.segments,
+            g.corners,
+            self.n_links,
+            loop,
+            guides,
+            np.zeros(0) if soil else None,
+        )
+        self.work = work_arrays(self.m, self.nw, self.n_links)
+        self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
+        self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
+        self.pins, self.psi = loop_pins(geometry)
+        self.slide0 = geometry.slide
+        self.weight = (total_mass(vehicle, track) + track["pin_mass"] + loop[L.LP_IDLER_MASS]) * gravity
+
+    def q_of(self, u):
+        q = np.zeros(self.nq)
+        q[L.Q_Y] = u[0]
+        q[L.Q_PITCH] = u[1]
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
+        q[L.q_idler(self.nw, self.n_links)] = u[2]
+        q[L.q_sprocket(self.nw, self.n_links)] = u[3]
+        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[4:]
+        return q
+
+    def _args(self):
+        return self.phi, self.psi, self.m, self.work, self.diag
+
+    def residual(self, u):
+        r = np.empty(u.size)
+        arm_moment = np.empty(self.nw)
+        fx = _loop_residual(u, *self._args(), r, arm_moment)
+        return r, fx, arm_moment
+
+    def jacobian(self, u, h=1e-7):
+        J = np.empty((u.size, u.size))
+        _loop_jacobian(u, h, *self._args(), J)
+        return J
+
+
+@njit(**KERNEL)
+def _loop_jacobian(u, h, phi, psi, m, w, diag, J):
+    """Central finite differences of _loop_residual (compiled: ~270 residuals a step)."""
+    n = u.shape[0]
+    rp = np.empty(n)
+    rm = np.empty(n)
+    am = np.empty(m.arms.shape[0])
+    up = u.copy()
+    for k in range(n):
+        up[k] = u[k] + h
+        _loop_residual(up, phi, psi, m, w, diag, rp, am)
+        up[k] = u[k] - h
+        _loop_residual(up, phi, psi, m, w, diag, rm, am)
+        up[k] = u[k]
+        for i in range(n):
+            v = (rp[i] - rm[i]) / (2.0 * h)
+            J[i, k] = v if abs(v) > 1e-200 else 0.0   # no subnormals: LAPACK slows down 50x on them
+
+
+@njit(**KERNEL)
+def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
+    """The closed layout's generalised forces at rest (loop.loop_rhs fills w.genf) on the
+    unknowns into r (on the sprocket angle: its change, which holds it), each arm's moment
+    about its pivot; returns the horizontal force."""
+    nw = m.arms.shape[0]
+    n = w.apos.shape[0] - 1
+    nq = w.genf.shape[0]
+    y = np.zeros(n_state(nq))
+    y[L.Q_Y] = u[0]
+    y[L.Q_PITCH] = u[1]
+    for i in range(nw):
+        y[L.Q_ARM + i] = phi
+    y[q_idler(nw, n)] = u[2]
+    y[q_sprocket(nw, n)] = u[3]
+    off = pin_offset(nw)
+    for k in range(2 * n):
+        y[off + k] = u[4 + k]
+    ydot = np.empty(y.shape[0])
+    loop_rhs(y, m, w, ydot, diag)
+    r[0] = w.genf[L.Q_Y]
+    r[1] = w.genf[L.Q_PITCH]
+    r[2] = w.genf[q_idler(nw, n)]
+    r[3] = u[3] - psi     # held by the drive
+    for k in range(2 * n):
+        r[4 + k] = w.genf[off + k]
+    for i in range(nw):
+        arm_moment[i] = w.genf[L.Q_ARM + i]
+    return w.genf[L.Q_X]
+
+

@@ -1,0 +1,125 @@
+"""What one run is: vehicle + track + terrain + run settings, validated before anything runs.
+
+A scenario is a nested dict with dotted names (``speed``, ``vehicle.chassis_mass``,
+``terrain.height``); ``Scenario.from_dict`` fills every missing value from the
+paper's run and raises ``ScenarioError`` (one line, naming the parameter and what is
+allowed) on anything wrong. The parameter table is parameters_table.py; the checks per
+area are check_*.py.
+"""
+
+import copy
+from dataclasses import dataclass
+
+
+class ScenarioError(ValueError):
+    """Bad scenario input; the message is one line naming the culprit."""
+
+
+# below ScenarioError: the check modules import it from this package
+from .check_closed import check_closed  # noqa: E402
+from .check_run import apply_preset, check_extensions, check_sampling  # noqa: E402
+from .check_terrain import check_placed_by_time, validate_terrain  # noqa: E402
+from .check_values import check_value, dotted_keys, flatten, merge, set_dotted, unknown  # noqa: E402
+from .check_vehicle import check_geometry  # noqa: E402
+from .parameters_table import (  # noqa: E402
+    METHODS,
+    OBSTACLE_KINDS,
+    OPEN_LOW,
+    PLACEMENT_KEYS,
+    RULES,
+    SOLVERS,
+    TERRAIN_KINDS,
+    TERRAIN_RULES,
+    UNITS,
+    paper_step,
+    parameter_names,
+)
+
+__all__ = [
+    "Scenario",
+    "ScenarioError",
+    "validate",
+    "validate_terrain",
+    "flatten",
+    "set_dotted",
+    "paper_step",
+    "parameter_names",
+    "RULES",
+    "UNITS",
+    "TERRAIN_RULES",
+    "SOLVERS",
+    "METHODS",
+    "TERRAIN_KINDS",
+    "OBSTACLE_KINDS",
+    "PLACEMENT_KEYS",
+]
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated, fully resolved scenario. Build with from_dict or paper().
+    explicit: the dotted names set by the user rather than by defaults or a preset."""
+
+    data: dict
+    explicit: frozenset = frozenset()
+
+    @classmethod
+    def paper(cls, **overrides):
+        return cls.from_dict(overrides)
+
+    @classmethod
+    def from_dict(cls, overrides=None, base=None, explicit=None):
+        """Defaults (the paper's run, or ``base``) updated by ``overrides``; keys may be
+        nested tables or dotted names. A base given as a plain dict counts as explicit
+        throughout (it is a resolved scenario: its preset values stay as they are)."""
+        d = copy.deepcopy(base if base is not None else paper_step())
+        if explicit is None:
+            explicit = frozenset(flatten(d)) if base is not None else frozenset()
+        nested = {}
+        for k, v in (overrides or {}).items():
+            if not isinstance(k, str):
+                raise ScenarioError(f"parameter names must be text, got {k!r}")
+            if "." in k and not k.startswith("terrain."):
+                if k not in RULES:
+                    raise unknown(k, parameter_names())
+            set_dotted(nested, k, v)
+        merge(d, nested)
+        explicit = frozenset(explicit | dotted_keys(nested))
+        d["preset"] = check_value("preset", d.get("preset"), RULES["preset"])
+        apply_preset(d, explicit)
+        return cls(validate(d, explicit), explicit)
+
+    def with_overrides(self, overrides):
+        return Scenario.from_dict(overrides, base=self.data, explicit=self.explicit)
+
+    def to_dict(self):
+        return copy.deepcopy(self.data)
+
+    def __getitem__(self, name):
+        d = self.data
+        for p in name.split("."):
+            d = d[p]
+        return d
+
+    @property
+    def name(self):
+        return self.data["name"]
+
+
+def validate(d, explicit=frozenset()):
+    """The resolved scenario d checked area by area (values, terrain, sampling, geometry,
+    extensions, closed track), as a new dict with values converted and derived ones filled in."""
+    out = copy.deepcopy(d)
+    flat = flatten({k: v for k, v in d.items() if k != "terrain"})
+    for name, value in flat.items():
+        if name not in RULES:
+            raise unknown(name, parameter_names())
+        set_dotted(out, name, check_value(name, value, RULES[name], name in OPEN_LOW))
+    out["terrain"] = validate_terrain(d["terrain"])
+    check_sampling(out)
+    check_geometry(out["vehicle"], out["track"])
+    check_placed_by_time(out)
+    out["vehicle"]["arm_damping"] = [float(a) for a in out["vehicle"]["arm_damping"]]
+    check_extensions(out, explicit)
+    check_closed(out, explicit)
+    return out

@@ -1,0 +1,97 @@
+"""Run-wide checks: presets filled in, the output sampling against the duration, and the
+models beyond the paper (coefficients that belong together, what the lee solver runs)."""
+
+import copy
+import math
+
+from ..presets import PRESETS, preset_values
+from . import ScenarioError
+from .check_values import flatten, set_dotted
+from .parameters_table import paper_step
+
+
+def apply_preset(d, explicit):
+    """Every parameter a preset may set takes the scenario's preset value (or the paper's
+    where this preset leaves it), unless it was given explicitly."""
+    paper = flatten(paper_step())
+    values = preset_values(d["preset"], d)
+    controlled = set()
+    for name in PRESETS:
+        controlled |= set(preset_values(name, d))
+    for name in controlled - set(explicit):
+        set_dotted(d, name, copy.deepcopy(values.get(name, paper[name])))
+
+
+def check_sampling(out):
+    """The output interval fits the duration, and the run keeps at most 2,000,000 samples."""
+    if out["output_interval"] > out["duration"]:
+        raise ScenarioError(
+            f"output_interval = {out['output_interval']} s is longer than duration = "
+            f"{out['duration']} s; allowed: (0, duration]"
+        )
+    if out["duration"] / out["output_interval"] > 2_000_000:
+        raise ScenarioError(
+            "output_interval is too small for this duration: at most 2,000,000 output samples"
+        )
+
+
+def check_extensions(d, explicit):
+    """The models beyond the paper: coefficients that belong together, sizes that must
+    match, and what the lee solver supports."""
+    _check_contact_damping(d["contact"], explicit)
+    _check_arm_damping(d["vehicle"])
+    if d["solver"] == "lee":
+        _check_lee(d)
+
+
+def _check_contact_damping(c, explicit):
+    if c["damping"] == "viscous" and c["damping_ratio"] <= 0.0:
+        raise ScenarioError(
+            "contact.damping = 'viscous' needs contact.damping_ratio > 0 (e.g. 0.1); "
+            "or contact.damping = 'none'"
+        )
+    if (
+        c["damping"] in ("hunt_crossley", "lankarani_nikravesh", "flores")
+        and "contact.restitution" not in explicit
+    ):
+        raise ScenarioError(
+            f"contact.damping = '{c['damping']}' needs contact.restitution, a number in (0, 1] (e.g. 0.75)"
+        )
+
+
+def _check_arm_damping(v):
+    arms = v["arm_damping"]
+    n = v["n_wheels"]
+    if arms and len(arms) != n:
+        raise ScenarioError(
+            f"vehicle.arm_damping has {len(arms)} values for {n} road wheels: give one per wheel "
+            "(0 = no shock absorber), or [] for none"
+        )
+    for i, a in enumerate(arms):
+        if isinstance(a, bool) or not isinstance(a, (int, float)) or not (math.isfinite(a) and a >= 0.0):
+            raise ScenarioError(
+                f"vehicle.arm_damping[{i}] = {a!r} is not allowed: expected a number >= 0 (N m s/rad)"
+            )
+
+
+def _check_lee(d):
+    """The lee solver runs the paper's model: the first extension set is named."""
+    c = d["contact"]
+    ext = [
+        name
+        for name, on in (
+            ("contact.law", c["law"] != "linear"),
+            ("contact.damping", c["damping"] != "none"),
+            ("contact.geometry", c["geometry"] != "paper"),
+            ("contact.friction", c["friction"] > 0),
+            ("track.link_damping", d["track"]["link_damping"] > 0),
+            ("terrain.soil", d["terrain"].get("soil", "rigid") != "rigid"),
+            ("vehicle.arm_damping", any(a > 0 for a in d["vehicle"]["arm_damping"])),
+        )
+        if on
+    ]
+    if ext:
+        raise ScenarioError(
+            f"solver = 'lee' runs the paper's model only, but {ext[0]} is set; "
+            "use solver = 'reduced' for the models beyond the paper"
+        )

@@ -1,0 +1,273 @@
+"""The parameter table: the paper's defaults and, for every dotted name, its type, bounds,
+allowed values and unit. Data only; the checks that read it sit beside it (check_*.py)."""
+
+import math
+
+from ..model.contact.laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
+from ..model.core.indices import DRIVES
+from ..model.vehicle.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle
+from ..presets import PRESETS
+from ..solvers.registry import METHODS
+from ..solvers.registry import SOLVERS as _REGISTRY
+
+SOLVERS = tuple(_REGISTRY)  # the time integrators by name: solvers/registry.py
+TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
+OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
+PLACEMENT_KEYS = ("position", "first_contact_time", "gap")  # where an obstacle stands: one of them
+PAPER_FIRST_CONTACT_TIME = 0.0568  # s: also the default of a first obstacle given no placement
+# the groups only the closed track layout uses (track.tension too)
+CLOSED_GROUPS = ("sprocket", "idler", "rollers", "drive", "drawbar")
+
+
+def paper_step():
+    """The paper's run: 10 m/s over a 0.1 m step first touched at t = 0.0568 s."""
+    return {
+        "name": "paper_step",
+        "preset": "paper",
+        "speed": 10.0,
+        "duration": 0.5,
+        "gravity": GRAVITY,
+        "solver": "reduced",
+        "method": "dopri5",
+        "tolerance": 1e-9,
+        "output_interval": 1e-4,
+        "max_steps": 2_000_000,
+        "perturbation": 0.0,  # m: seeded nudge of the free pins (study replicates)
+        "seed": 0,
+        "vehicle": paper_vehicle(),
+        "track": paper_track(),
+        "contact": paper_contact(),
+        "terrain": {"kind": "step", "height": 0.1, "first_contact_time": PAPER_FIRST_CONTACT_TIME},
+        **closed_defaults(),
+        "lee": {
+            "accel_order": 10,
+            "eps_iterations": 10,
+            "position_tol": 1e-9,
+            "max_iterations": 500,
+            "matrix_update_angle": 1e-3,
+        },
+        "record": {"enabled": True, "every": 5},  # side-view frames: every 5th output sample
+    }
+
+
+# name -> (type, low, high, what is allowed). Bounds are exclusive where marked by the text.
+_POS = (float, 0.0, math.inf, "a number > 0")
+_NONNEG = (float, 0.0, math.inf, "a number >= 0")
+RULES = {
+    "name": (str, None, None, "a text"),
+    "preset": (str, tuple(PRESETS), None, "one of " + ", ".join(PRESETS)),
+    "speed": (float, 0.0, 100.0, "a number in [0, 100] m/s"),
+    "duration": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
+    "gravity": (float, 0.0, 100.0, "a number in [0, 100] m/s^2"),
+    "solver": (str, SOLVERS, None, "one of " + ", ".join(SOLVERS)),
+    "method": (str, METHODS, None, "one of " + ", ".join(METHODS)),
+    "tolerance": (float, 1e-14, 1e-3, "a number in [1e-14, 1e-3]"),
+    "output_interval": _POS,
+    "max_steps": (int, 1, 10**9, "an integer >= 1"),
+    "perturbation": (float, 0.0, 1e-3, "a number in [0, 1e-3] m"),
+    "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
+    "vehicle.chassis_mass": _POS,
+    "vehicle.chassis_inertia": _POS,
+    "vehicle.arm_mass": _POS,
+    "vehicle.arm_inertia": _POS,
+    "vehicle.arm_length": _POS,
+    "vehicle.arm_angle": (float, 0.0, 90.0, "a number in (0, 90) deg"),
+    "vehicle.torsion_stiffness": _POS,
+    "vehicle.wheel_radius": _POS,
+    "vehicle.n_wheels": (int, 2, 20, "an integer in [2, 20]"),
+    "vehicle.first_pivot_x": (float, -math.inf, math.inf, "a finite number (m)"),
+    "vehicle.pivot_y": (float, -math.inf, math.inf, "a finite number (m)"),
+    "vehicle.pivot_spacing": _POS,
+    "vehicle.front_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
+    "vehicle.rear_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
+    "track.n_links": (int, 4, 400, "an integer in [4, 400]"),
+    "track.link_length": _POS,
+    "track.pin_mass": _POS,
+    "track.link_stiffness": _POS,
+    "track.pad_wheel": _POS,
+    "track.pad_ground": _POS,
+    "track.wheel_stiffness": _POS,
+    "track.ground_stiffness": _POS,
+    "track.link_damping": (float, 0.0, math.inf, "a number >= 0 (N s/m)"),
+    "vehicle.arm_damping": (list, None, None, "a list of one number >= 0 (N m s/rad) per road wheel, or []"),
+    "contact.law": (str, tuple(LAWS), None, "one of " + ", ".join(LAWS)),
+    "contact.exponent": (float, 0.0, 3.0, "a number in (0, 3]"),
+    "contact.damping": (str, tuple(DAMPINGS), None, "one of " + ", ".join(DAMPINGS)),
+    "contact.damping_ratio": (float, 0.0, 10.0, "a number in [0, 10]"),
+    "contact.restitution": (float, 0.0, 1.0, "a number in (0, 1]"),
+    "contact.damping_ramp": (float, 0.0, 0.1, "a number in (0, 0.1] m"),
+    "contact.min_approach_speed": (float, 0.0, 100.0, "a number in (0, 100] m/s"),
+    "contact.geometry": (str, tuple(GEOMETRIES), None, "one of " + ", ".join(GEOMETRIES)),
+    "contact.friction": (float, 0.0, 10.0, "a number in [0, 10] (Coulomb mu; 0 = frictionless)"),
+    "contact.friction_velocity": (float, 0.0, 10.0, "a number in (0, 10] m/s"),
+    "contact.friction_law": (str, tuple(FRICTION_LAWS), None, "one of " + ", ".join(FRICTION_LAWS)),
+    "contact.friction_stiffness": (
+        float,
+        0.0,
+        1e12,
+        "a number in (0, 1e12] (N/m: the bristle's tangential stiffness)",
+    ),
+    "track.layout": (str, ("paper", "closed"), None, "one of paper, closed"),
+    "track.tension": (float, 0.0, 1e7, "a number > 0 (N)"),
+    "track.width": (float, 0.0, 10.0, "a number in (0, 10] m"),
+    "sprocket.position": (str, ("rear", "front"), None, "one of rear, front"),
+    "sprocket.teeth": (int, 3, 60, "an integer in [3, 60]"),
+    "sprocket.pitch_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived from the link pitch)"),
+    "sprocket.seat_radius": _POS,
+    "sprocket.pin_radius": _POS,
+    "sprocket.tip_radius": (float, 0.0, 10.0, "a number >= 0 (m; 0: derived)"),
+    "sprocket.flank_angle": (float, 0.0, 45.0, "a number in [0, 45] deg"),
+    "sprocket.stiffness": _POS,
+    "sprocket.inertia": _POS,
+    "idler.radius": _POS,
+    "idler.mass": _POS,
+    "idler.preload": (float, 0.0, 1e8, "a number >= 0 (N; 0: derived from track.tension)"),
+    "idler.stiffness": _NONNEG,
+    "idler.damping": _NONNEG,
+    "idler.travel": _POS,
+    "idler.guide_angle": (float, -60.0, 60.0, "a number in [-60, 60] deg"),
+    "rollers.positions": (list, None, None, "a list of [x, y] body points (m), or []"),
+    "rollers.radius": _POS,
+    "drive.kind": (str, tuple(DRIVES), None, "one of " + ", ".join(DRIVES)),
+    "drive.torque": (float, -1e7, 1e7, "a number in [-1e7, 1e7] N m"),
+    "drive.curve": (
+        list,
+        None,
+        None,
+        "a list of [sprocket speed rad/s, torque N m] pairs, speeds increasing, or []",
+    ),
+    "drive.target": (float, -100.0, 100.0, "a number in [-100, 100] m/s (default: the start speed)"),
+    "drive.gain_p": _NONNEG,
+    "drive.gain_i": _NONNEG,
+    "drive.torque_limit": _POS,
+    "drawbar.load": (float, -1e7, 1e7, "a number in [-1e7, 1e7] N (rearward positive; 0: none)"),
+    "drawbar.hitch": (list, None, None, "a pair [x, y] of finite numbers (m, body point)"),
+    "drawbar.slip": (float, 0.0, 0.95, "a number in [0, 0.95] (0: no towing rig)"),
+    "drawbar.rig_damping": (float, 0.0, math.inf, "a number > 0 (N s/m)"),
+    "lee.accel_order": (int, 1, 50, "an integer in [1, 50]"),
+    "lee.eps_iterations": (int, 1, 1000, "an integer in [1, 1000]"),
+    "lee.position_tol": (float, 1e-15, 1e-3, "a number in [1e-15, 1e-3] m"),
+    "lee.max_iterations": (int, 1, 100000, "an integer >= 1"),
+    "lee.matrix_update_angle": (float, 0.0, 1.0, "a number in [0, 1] rad (0: rebuild A_n after every step)"),
+    "record.enabled": (bool, None, None, "true or false"),
+    "record.every": (int, 1, 10**6, "an integer >= 1"),
+}
+# The unit of every parameter that has one (axis labels and titles of the figures).
+UNITS = {
+    "speed": "m/s",
+    "duration": "s",
+    "gravity": "m/s^2",
+    "output_interval": "s",
+    "perturbation": "m",
+    "vehicle.chassis_mass": "kg",
+    "vehicle.chassis_inertia": "kg m^2",
+    "vehicle.arm_mass": "kg",
+    "vehicle.arm_inertia": "kg m^2",
+    "vehicle.arm_length": "m",
+    "vehicle.arm_angle": "deg",
+    "vehicle.torsion_stiffness": "N m/rad",
+    "vehicle.wheel_radius": "m",
+    "vehicle.first_pivot_x": "m",
+    "vehicle.pivot_y": "m",
+    "vehicle.pivot_spacing": "m",
+    "vehicle.front_track_end": "m",
+    "vehicle.rear_track_end": "m",
+    "track.link_length": "m",
+    "track.pin_mass": "kg",
+    "track.link_stiffness": "N/m",
+    "track.pad_wheel": "m",
+    "track.pad_ground": "m",
+    "track.wheel_stiffness": "N/m",
+    "track.ground_stiffness": "N/m",
+    "track.link_damping": "N s/m",
+    "vehicle.arm_damping": "N m s/rad",
+    "contact.damping_ramp": "m",
+    "contact.min_approach_speed": "m/s",
+    "contact.friction_velocity": "m/s",
+    "contact.friction_stiffness": "N/m",
+    "track.tension": "N",
+    "track.width": "m",
+    "sprocket.pitch_radius": "m",
+    "sprocket.seat_radius": "m",
+    "sprocket.pin_radius": "m",
+    "sprocket.tip_radius": "m",
+    "sprocket.flank_angle": "deg",
+    "sprocket.stiffness": "N/m",
+    "sprocket.inertia": "kg m^2",
+    "idler.radius": "m",
+    "idler.mass": "kg",
+    "idler.preload": "N",
+    "idler.stiffness": "N/m",
+    "idler.damping": "N s/m",
+    "idler.travel": "m",
+    "idler.guide_angle": "deg",
+    "rollers.positions": "m",
+    "rollers.radius": "m",
+    "drive.torque": "N m",
+    "drive.target": "m/s",
+    "drive.gain_p": "N m s/m",
+    "drive.gain_i": "N m/m",
+    "drive.torque_limit": "N m",
+    "drawbar.load": "N",
+    "drawbar.hitch": "m",
+    "drawbar.rig_damping": "N s/m",
+    "lee.position_tol": "m",
+    "lee.matrix_update_angle": "rad",
+    "terrain.height": "m",
+    "terrain.length": "m",
+    "terrain.position": "m",
+    "terrain.first_contact_time": "s",
+    "terrain.gap": "m",
+}
+
+# the names whose low bound is itself not allowed
+OPEN_LOW = {
+    "duration",
+    "drawbar.rig_damping",
+    "tolerance",
+    "output_interval",
+    "vehicle.arm_angle",
+    "contact.exponent",
+    "track.width",
+    "contact.restitution",
+    "contact.damping_ramp",
+    "contact.min_approach_speed",
+    "contact.friction_velocity",
+    "contact.friction_stiffness",
+} | {k for k, r in RULES.items() if r is _POS}
+
+# terrain.* and obstacle keys: the terrain table is checked as a whole (its keys depend on its kind)
+TERRAIN_RULES = {
+    "kind": (str, TERRAIN_KINDS, None, "one of " + ", ".join(TERRAIN_KINDS)),
+    "height": (float, 0.0, 10.0, "a number in (0, 10] m"),
+    "length": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
+    "position": (float, -900.0, 900.0, "a number in [-900, 900] m (x of the obstacle's start)"),
+    "first_contact_time": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
+    "gap": (float, 0.0, 1000.0, "a number in [0, 1000] m"),
+    "points": (list, None, None, "a list of [x, y] pairs with x non-decreasing"),
+    "obstacles": (list, None, None, "a list of obstacle tables"),
+    "soil": (str, None, None, "rigid, a soil name (trackbench params) or a table of soil values"),
+}
+TERRAIN_OPEN_LOW = ("height", "length", "first_contact_time")
+OBSTACLE_KIND_RULE = (str, OBSTACLE_KINDS, None, "one of " + ", ".join(OBSTACLE_KINDS))
+# the keys each kind takes: as the whole terrain, and as one obstacle of a sequence
+TERRAIN_KEYS = {
+    "flat": set(),
+    "step": {"height", "position", "first_contact_time"},
+    "ramp": {"height", "length", "position"},
+    "block": {"height", "length", "position", "first_contact_time"},
+    "bump": {"height", "length", "position"},
+    "points": {"points"},
+    "sequence": {"obstacles"},
+}
+OBSTACLE_KEYS = {
+    "step": {"height", "position", "gap", "first_contact_time"},
+    "ramp": {"height", "length", "position", "gap"},
+    "block": {"height", "length", "position", "gap", "first_contact_time"},
+    "bump": {"height", "length", "position", "gap"},
+}
+
+
+def parameter_names():
+    """Every dotted name a scenario accepts (terrain keys included)."""
+    return sorted(RULES) + sorted("terrain." + k for k in TERRAIN_RULES)

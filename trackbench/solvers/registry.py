@@ -1,0 +1,45 @@
+"""The time integrators by name: what `solver = "..."` and `method = "..."` may say, and the
+function that runs each. An entry names its module and function as text, so the registry
+loads nothing (scenario validation reads it without numba); `run_function` imports the
+solver on first use. A new integrator adds one entry here and follows the contract in
+solvers/base.py."""
+
+import importlib
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class SolverEntry:
+    name: str  # the value of `solver`
+    module: str  # where its run(scenario, model, y0) -> RunResult lives
+    methods: tuple  # the values `method` may take with it ("" = it has no choice)
+    closed_track: bool  # whether it integrates the closed track
+    summary: str
+
+
+SOLVERS = {
+    e.name: e
+    for e in (
+        SolverEntry(
+            "reduced",
+            "trackbench.solvers.rk.rk_run",
+            ("dop853", "dopri5"),
+            True,
+            "reduced coordinates, embedded explicit Runge-Kutta pairs (DOP853, DOPRI5)",
+        ),
+        SolverEntry(
+            "lee",
+            "trackbench.solvers.lee.lee_run",
+            ("dop853", "dopri5"),
+            False,
+            "the paper's method: absolute coordinates, Lee's accelerated iteration, RKN6(4)",
+        ),
+    )
+}
+# every method any solver takes (scenario validation's allowed values)
+METHODS = tuple(sorted({m for e in SOLVERS.values() for m in e.methods if m}))
+
+
+def run_function(name):
+    """The run(scenario, model, y0) of the solver called `name`."""
+    return importlib.import_module(SOLVERS[name].module).run

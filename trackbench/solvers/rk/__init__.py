@@ -1,0 +1,1 @@
+"""Embedded explicit Runge-Kutta pairs (DOPRI5, DOP853) on the reduced coordinates."""

@@ -1,0 +1,17 @@
+"""Python side of the reduced-coordinate solver: validate nothing (the scenario did),
+allocate, call the compiled loop."""
+
+from ...model.core import indices as L
+from ...model.core.bundles import event_arrays
+from ..base import allocate_outputs, control, trimmed
+from .rk_loop import integrate, loop_arrays
+from .tableau import TABLEAUS
+
+
+def run(scenario, model, y0):
+    tab = TABLEAUS[scenario["method"]].arrays()
+    out = allocate_outputs(scenario, model, y0.size)
+    lw = loop_arrays(tab.b.shape[0], y0.size, L.n_diag(model.nw, model.n_links), model.n_links + 1)
+    ev = event_arrays(model.nw, model.n_links, model.arrays.guides.shape[0] if model.closed else None)
+    integrate(y0, control(scenario), tab, model.arrays, model.work, ev, lw, out)
+    return trimmed(scenario, out)
