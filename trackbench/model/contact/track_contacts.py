@@ -39,10 +39,22 @@ from ..core.indices import (
     P_WHEEL_RADIUS,
 )
 from ..core.jit import BORROW, INLINE
-from ..vehicle.links import _link_load
 from .gaps import pin_cap_weight, point_on_link
 from .laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from .laws_jit import friction, normal_force
+
+
+@njit(**BORROW)
+def _link_load(fpin, avel, b, d0, length, fx, fy):
+    """Eq. (7): split a force on link b at distance d0 from pin b to pins b and b+1;
+    returns the power of the split force."""
+    w1 = d0 / length
+    w0 = 1.0 - w1
+    fpin[b, 0] += w0 * fx
+    fpin[b, 1] += w0 * fy
+    fpin[b + 1, 0] += w1 * fx
+    fpin[b + 1, 1] += w1 * fy
+    return (w0 * avel[b, 0] + w1 * avel[b + 1, 0]) * fx + (w0 * avel[b, 1] + w1 * avel[b + 1, 1]) * fy
 
 
 @njit(**INLINE)

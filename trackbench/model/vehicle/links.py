@@ -18,7 +18,7 @@ from ..core.indices import (
     P_LINK_LENGTH,
     P_LINK_STIFFNESS,
 )
-from ..core.jit import BORROW, INLINE
+from ..core.jit import INLINE
 
 
 @njit(**INLINE)
@@ -61,16 +61,3 @@ def link_tensions(apos, avel, par, lk, fpin, diag, t_off):
     diag[D_MAX_TENSION] = tmax
     diag[D_DISSIPATION] += dissipation
     diag[D_POWER] -= dissipation  # the dashpots' work on the pins
-
-
-@njit(**BORROW)
-def _link_load(fpin, avel, b, d0, length, fx, fy):
-    """Eq. (7): split a force on link b at distance d0 from pin b to pins b and b+1;
-    returns the power of the split force."""
-    w1 = d0 / length
-    w0 = 1.0 - w1
-    fpin[b, 0] += w0 * fx
-    fpin[b, 1] += w0 * fy
-    fpin[b + 1, 0] += w1 * fx
-    fpin[b + 1, 1] += w1 * fy
-    return (w0 * avel[b, 0] + w1 * avel[b + 1, 0]) * fx + (w0 * avel[b, 1] + w1 * avel[b + 1, 1]) * fy
