@@ -187,7 +187,7 @@ def test_speed_drive_pi_and_anti_windup():
 RT = 0.3236 + 0.027
 
 
-def _loop_vector(teeth=10, rp=0.3236, rg=0.03, rt=RT, rpin=0.027):
+def _closed_vector(teeth=10, rp=0.3236, rg=0.03, rt=RT, rpin=0.027):
     lp = np.zeros(L.N_LOOP)
     lp[[L.LP_TEETH, L.LP_PITCH_RADIUS, L.LP_SEAT_RADIUS, L.LP_TIP_RADIUS, L.LP_PIN_RADIUS]] = (
         teeth,
@@ -203,7 +203,7 @@ def _loop_vector(teeth=10, rp=0.3236, rg=0.03, rt=RT, rpin=0.027):
 def test_tooth_profile_distance_matches_the_drawn_profile():
     """The pin's penetration is r_pin minus its distance to the profile: checked against a
     finely drawn profile at random points outside the teeth."""
-    lp = _loop_vector()
+    lp = _closed_vector()
     poly = profile(10, 0.3236, 0.03, RT, 0.027, angle=0.3, per_arc=600)
     rng = np.random.default_rng(1)
     checked = 0
@@ -224,7 +224,7 @@ def test_tooth_profile_distance_matches_the_drawn_profile():
 
 
 def test_seated_pin_on_the_pitch_circle_just_touches():
-    lp = _loop_vector()
+    lp = _closed_vector()
     pen, nx, ny, inside = pin_on_sprocket(0.3236 * math.cos(0.3), 0.3236 * math.sin(0.3), 0.3, lp)
     assert not inside
     assert pen == pytest.approx(0.0, abs=1e-12)

@@ -95,10 +95,10 @@ def test_event_contact_decision_equals_the_kernels(geometry, request):
 
 def test_closed_event_contact_decision_equals_the_kernels():
     """The closed layout: road wheels, idler, ground and the sprocket's teeth as the event
-    location sees them (its scratch placed by loop.place_loop) carry the kernels' pad
+    location sees them (its scratch placed by loop.place_closed) carry the kernels' pad
     energies, pins moved within a pad's depth of every threshold."""
     from trackbench.model.core.bundles import event_arrays
-    from trackbench.model.dynamics.closed_track_jit import loop_rhs, place_loop
+    from trackbench.model.dynamics.closed_track_jit import closed_rhs, place_closed
     from trackbench.model.vehicle.teeth_jit import tooth_shape
     from trackbench.simulate import initial_state
     from trackbench.solvers.common.events import _teeth_gap
@@ -119,10 +119,10 @@ def test_closed_event_contact_decision_equals_the_kernels():
         y[off : off + 2 * n] += rng.uniform(-0.01, 0.01, 2 * n)
         y[i_s] += rng.uniform(-0.05, 0.05)
         d = np.zeros(L.n_diag(model.nw, n))
-        loop_rhs(y, m, w, np.zeros_like(y), d)
+        closed_rhs(y, m, w, np.zeros_like(y), d)
         if d[L.D_STATUS] != 0.0:
             continue
-        place_loop(y[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
+        place_closed(y[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
         pins = np.vstack([ev.pins0, ev.pins0[1]])  # pin 1 after pin n_links
         energy = _event_energy(
             m, ev, pins, {L.K_WHEEL_PIN: ev.wheels0, L.K_GUIDE_PIN: ev.guides0, L.K_CORNER_PIN: m.corners}

@@ -32,13 +32,13 @@ def _closed_key(scenario):
 
 @functools.lru_cache(maxsize=32)
 def _closed_parts_cached(key):
-    from .model.vehicle.closed_track import closed_geometry, guide_table, loop_vector
+    from .model.vehicle.closed_track import closed_geometry, closed_vector, guide_table
     vehicle, track, gravity, contact, spr, idl, rol, drive, drawbar = json.loads(key)
     g = closed_geometry(vehicle, track, spr, idl, rol, frozenset({"track.n_links"}))
     c = 0.0
     if contact["damping"] == "viscous":   # the contacts' rule: c = 2 zeta sqrt(k m_pin)
         c = 2.0 * contact["damping_ratio"] * np.sqrt(spr["stiffness"] * track["pin_mass"])
-    return g, loop_vector(g, spr, idl, drive, c, drawbar), guide_table(g, track, idl, rol)
+    return g, closed_vector(g, spr, idl, drive, c, drawbar), guide_table(g, track, idl, rol)
 
 
 def closed_parts(scenario: Scenario):
@@ -47,25 +47,25 @@ def closed_parts(scenario: Scenario):
 
 
 @functools.lru_cache(maxsize=32)
-def _loop_equilibrium_cached(key, soil):
+def _closed_equilibrium_cached(key, soil):
     from .model.vehicle.closed_track import without_drawbar
-    from .solvers.equilibrium.static import solve_loop_equilibrium
+    from .solvers.equilibrium.static import solve_closed_equilibrium
     vehicle, track, gravity, contact, *_ = json.loads(key)
     g, lp, guides = _closed_parts_cached(key)
-    return solve_loop_equilibrium(vehicle, track, gravity, contact, g, without_drawbar(lp), guides,
+    return solve_closed_equilibrium(vehicle, track, gravity, contact, g, without_drawbar(lp), guides,
                                   {int(k): v for k, v in json.loads(soil).items()})
 
 
 def equilibrium(scenario: Scenario):
     """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
     if _closed(scenario):
-        return _loop_equilibrium_cached(_closed_key(scenario), json.dumps(soil_par(scenario)))
+        return _closed_equilibrium_cached(_closed_key(scenario), json.dumps(soil_par(scenario)))
     key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"],
                       soil_par(scenario)], sort_keys=True)
     return _equilibrium_cached(key)
 
 
-def _loop_velocities(scenario, eq, y0):
+def _closed_velocities(scenario, eq, y0):
     """The closed track moving at `speed` without slip on the ground: every pin runs round
     the loop (clockwise, along its neighbours' chord) at `speed` relative to the chassis,
     the sprocket turns to match."""
@@ -96,7 +96,7 @@ def initial_state(scenario: Scenario, eq):
     closed = _closed(scenario)
     end = off + 2 * scenario["track.n_links"] if closed else nq
     if closed:
-        _loop_velocities(scenario, eq, y0)
+        _closed_velocities(scenario, eq, y0)
     else:
         y0[nq + off:2 * nq:2] = scenario["speed"]
     if scenario["perturbation"] > 0.0:

@@ -24,10 +24,10 @@ def _place(model, q):
     wheels = np.empty((n, nw, 2))
     q = np.ascontiguousarray(q)
     if model.closed:
-        from .model.dynamics.closed_track_jit import place_loop_samples
+        from .model.dynamics.closed_track_jit import place_closed_samples
         pins = np.empty((n, nl, 2))
         guides = np.empty((n, model.arrays.guides.shape[0], 2))
-        place_loop_samples(q, model.arrays, pins, wheels, guides)
+        place_closed_samples(q, model.arrays, pins, wheels, guides)
         return pins, wheels, guides
     pins = np.empty((n, nl + 1, 2))
     place_samples(q, model.par, model.arms, model.ends, pins, wheels)

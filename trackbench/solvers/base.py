@@ -45,7 +45,7 @@ Outputs = namedtuple("Outputs", [
     "y",         # (n_out, 2 nq + 1) reduced state (q, qd, W) at the output times
     "diag",      # (n_out, n_diag) forces and energies at the output times
     "peaks",     # (n_peaks, 6) value, time, then the last two samples (f, t)
-    "stats",     # (N_STATS,) layout.S_*
+    "stats",     # (N_STATS,) indices.S_*
 ])
 
 
@@ -55,7 +55,7 @@ class RunResult:
     y: np.ndarray             # (n_out, 2 nq + 1) reduced state (q, qd, W) at the output times
     diag: np.ndarray          # (n_out, n_diag) forces and energies at the output times
     peaks: np.ndarray         # (n_peaks, 6) value, time, then the last two samples (f, t)
-    stats: np.ndarray         # layout.S_*
+    stats: np.ndarray         # indices.S_*
     extra: dict = field(default_factory=dict)   # solver-specific arrays and figures
 
 

@@ -4,7 +4,7 @@ and the candidate lists that keep the contact search away from far-apart pairs.
 
 Every kernel takes the bundles of model/bundles.py: ``m`` (ModelArrays: parameters,
 ground, candidate lists), ``w`` (Work: pin and wheel kinematics in, forces out) and
-``diag`` (layout.D_*). The geometry of each contact (which side, which wedge, which
+``diag`` (indices.D_*). The geometry of each contact (which side, which wedge, which
 segment) is model/gaps.py.
 """
 

@@ -1,7 +1,7 @@
 """The arrays the compiled kernels share, bundled as named tuples: numba passes a bundle
 as one argument and reads its fields at no cost, so a kernel takes a few bundles rather
 than thirty arrays. The Python side allocates and fills them once per run (``allocate_*``);
-the kernels never allocate. What each array holds: model/layout.py."""
+the kernels never allocate. What each array holds: model/core/indices.py."""
 
 from collections import namedtuple
 
@@ -48,7 +48,7 @@ Work = namedtuple("Work", [
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
     "sink",       # (n_pins,) each pin's sinkage into soft soil at the last evaluation (m; 0 off it)
-    "grip",       # (n_pins, N_GRIP) bristle friction at the last evaluation (layout.G_*): the slip
+    "grip",       # (n_pins, N_GRIP) bristle friction at the last evaluation (indices.G_*): the slip
                   # limit mu p / k_t (m), the ground's unit tangent, the force, the pin's speed
                   # along the tangent; NaN off the ground
 ])
@@ -91,7 +91,7 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None,
 
 
 def work_arrays(m, n_wheels, n_links):
-    """Work for the paper's layout, LoopWork for the closed one (m.pins says which)."""
+    """Work for the paper's layout, ClosedWork for the closed one (m.pins says which)."""
     n_pins = n_links + 1
     closed = bool(m.pins[L.PN_CLOSED])
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
@@ -103,13 +103,13 @@ def work_arrays(m, n_wheels, n_links):
         return Work(*base)
     ng = m.guides.shape[0]
     nq = L.n_coordinates(n_wheels, n_links, closed=True)
-    return LoopWork(*base, np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros(L.N_SP),
+    return ClosedWork(*base, np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros(L.N_SP),
                     np.zeros((2, ARM_COLS + 1)), np.zeros(nq))
 
 
 # The closed layout's scratch: Work, then the idler and rollers as Work has the road wheels,
 # the sprocket and the generalised forces (the static equilibrium solves for them).
-LoopWork = namedtuple("LoopWork", list(Work._fields) + [
+ClosedWork = namedtuple("ClosedWork", list(Work._fields) + [
     "gc",         # (n_guides, 2) idler and roller centres
     "gv",         # (n_guides, 2) their velocities
     "fguide",     # (n_guides, 2) out: contact force of the track on each
@@ -118,22 +118,22 @@ LoopWork = namedtuple("LoopWork", list(Work._fields) + [
                   # Work.arm's, with their own diagonal mass in column ARM_COLS
     "genf",       # (nq,) out: generalised forces at rest (no inertia terms) for the equilibrium
 ])
-LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of LoopWork.extra
-ARM_D = ARM_COLS                   # column of LoopWork.extra: the diagonal mass
+LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of ClosedWork.extra
+ARM_D = ARM_COLS                   # column of ClosedWork.extra: the diagonal mass
 
 
 # Scratch of the event location (solvers/events.py): the configuration at both ends of
 # a rejected step; the closed layout's adds its idler and rollers.
 EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "arm"])
-LoopEventWork = namedtuple("LoopEventWork", list(EventWork._fields) + ["guides0", "guides1"])
+ClosedEventWork = namedtuple("ClosedEventWork", list(EventWork._fields) + ["guides0", "guides1"])
 
 
 def event_arrays(n_wheels, n_links, n_guides=None):
-    """EventWork for the paper's layout, LoopEventWork (n_guides: idler and rollers) for
+    """EventWork for the paper's layout, ClosedEventWork (n_guides: idler and rollers) for
     the closed one."""
     n_pins = n_links + 1
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
             np.zeros((n_wheels, ARM_COLS)))
     if n_guides is None:
         return EventWork(*base)
-    return LoopEventWork(*base, np.zeros((n_guides, 2)), np.zeros((n_guides, 2)))
+    return ClosedEventWork(*base, np.zeros((n_guides, 2)), np.zeros((n_guides, 2)))

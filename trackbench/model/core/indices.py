@@ -217,7 +217,7 @@ G_BY = 1
 G_REACH = 2              # wheel radius + pad h_w (m)
 N_G_COLS = 3
 
-# --- the sprocket's kinematics and loads, LoopWork.spr ------------------------------------
+# --- the sprocket's kinematics and loads, ClosedWork.spr ------------------------------------
 SP_X = 0                 # axis position and velocity (world)
 SP_Y = 1
 SP_VX = 2

@@ -1,4 +1,4 @@
-"""layout.py's index functions, compiled for the kernels (layout itself imports no
+"""indices.py's index functions, compiled for the kernels (indices.py itself imports no
 numba: scenario and study validation and the command line use it)."""
 
 from numba import njit

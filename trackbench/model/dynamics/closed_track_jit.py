@@ -2,7 +2,7 @@
 the road wheels, the idler and the support rollers (docs/model.md, "Beyond the paper: the
 closed, driven track").
 
-Coordinates (layout.py): the chassis, the arms, every pin (rows 1..n_links; row 0 of the
+Coordinates (model/core/indices.py): the chassis, the arms, every pin (rows 1..n_links; row 0 of the
 pin arrays copies row n_links), the sprocket angle psi relative to the chassis and the
 idler carrier's slide s along its guide. The sprocket turns about a chassis-fixed axis
 (its mass is part of the chassis'; its inertia I_s adds the kinetic energy
@@ -103,7 +103,7 @@ from .reduced import (
 
 
 @njit(**INLINE)
-def _loop_pins(coords, nw, out):
+def _closed_pins(coords, nw, out):
     """Rows 1..n_links from the pin coordinates (or rates), row 0 = row n_links."""
     n = out.shape[0] - 1
     for b in range(1, n + 1):
@@ -134,13 +134,13 @@ def guide_offset(j, sl, m, c, s):
 
 
 @njit(**INLINE)
-def place_loop(q, m, apos, wc, arm, gc):
+def place_closed(q, m, apos, wc, arm, gc):
     """Pins, road wheels, idler and rollers of configuration q (closed layout). Returns the
     pitch's (cos, sin)."""
     nw = m.arms.shape[0]
     n = apos.shape[0] - 1
     c, s = place_wheels(q, m.par, m.arms, wc, arm)
-    _loop_pins(q, nw, apos)
+    _closed_pins(q, nw, apos)
     sl = q[q_idler(nw, n)]
     for j in range(gc.shape[0]):
         rx, ry, _, _ = guide_offset(j, sl, m, c, s)
@@ -150,15 +150,15 @@ def place_loop(q, m, apos, wc, arm, gc):
 
 
 @njit(**INLINE)
-def _loop_positions(q, qd, m, w):
+def _closed_positions(q, qd, m, w):
     """Pins, wheels, idler and rollers with their velocities (each guide placed once), and
     the sprocket's axis and angle (w.spr)."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
     c, s = place_wheels(q, m.par, m.arms, w.wc, w.arm)
-    _loop_pins(q, nw, w.apos)
+    _closed_pins(q, nw, w.apos)
     wheel_velocities(qd, m.par, m.arms, w.wv, w.arm, c, s)
-    _loop_pins(qd, nw, w.avel)
+    _closed_pins(qd, nw, w.avel)
     om = qd[Q_PITCH]
     sl = q[q_idler(nw, n)]
     sd = qd[q_idler(nw, n)]
@@ -239,7 +239,7 @@ def _teeth(w, m, diag):
 
 
 @njit(**INLINE)
-def loop_loads(w, m, diag):
+def closed_loads(w, m, diag):
     """track_loads.track_loads for the closed layout: tension, road wheels, idler and rollers,
     ground, sprocket teeth; the forces on row 0 (the copy of pin n_links) moved to it."""
     par = m.par
@@ -293,7 +293,7 @@ def _idler(q, qd, m, w, c, s, force):
     n = w.apos.shape[0] - 1
     mi = m.loop[LP_IDLER_MASS]
     g = m.par[P_GRAVITY]
-    rx = w.gc[0, 0] - q[Q_X]           # placed by _loop_positions
+    rx = w.gc[0, 0] - q[Q_X]           # placed by _closed_positions
     ry = w.gc[0, 1] - q[Q_Y]
     ux, uy = body_offset(c, s, m.loop[LP_GUIDE_X], m.loop[LP_GUIDE_Y])
     om = qd[Q_PITCH]
@@ -321,7 +321,7 @@ def _forces_at_rest(f, w, nw, n, genf):
 
 
 @njit(**BORROW)
-def loop_rhs(y, m, w, ydot, diag):
+def closed_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for the closed layout (reduced.reduced_rhs for the paper's); fills diag
     and w.genf."""
     par, arms, lp = m.par, m.arms, m.loop
@@ -332,8 +332,8 @@ def loop_rhs(y, m, w, ydot, diag):
     n = w.apos.shape[0] - 1
     i_spr = q_sprocket(nw, n)
     i_idl = q_idler(nw, n)
-    c, s = _loop_positions(q, qd, m, w)
-    loop_loads(w, m, diag)
+    c, s = _closed_positions(q, qd, m, w)
+    closed_loads(w, m, diag)
     # the drive (forward = clockwise, psi counter-clockwise) and the tensioner
     omega = -qd[i_spr]
     tau, d_integral = drive_torque(lp, held_speed(lp, qd[Q_X], omega), omega, y[2 * nq + Y_DRIVE_INTEGRAL])
@@ -386,13 +386,13 @@ def loop_rhs(y, m, w, ydot, diag):
 
 
 @njit(**KERNEL)
-def place_loop_samples(qs, m, pins, wheels, guides):
-    """place_loop for every row of qs (output samples): pins (n, n_links, 2) (rows 1..n_links),
+def place_closed_samples(qs, m, pins, wheels, guides):
+    """place_closed for every row of qs (output samples): pins (n, n_links, 2) (rows 1..n_links),
     wheels (n, n_wheels, 2), idler and rollers (n, n_guides, 2)."""
     apos = np.empty((pins.shape[1] + 1, 2))
     arm = np.empty((m.arms.shape[0], ARM_COLS))
     for k in range(qs.shape[0]):
-        place_loop(qs[k], m, apos, wheels[k], arm, guides[k])
+        place_closed(qs[k], m, apos, wheels[k], arm, guides[k])
         for b in range(pins.shape[1]):
             pins[k, b, 0] = apos[b + 1, 0]
             pins[k, b, 1] = apos[b + 1, 1]

@@ -19,7 +19,7 @@ from ..core.indices_jit import n_coordinates, n_state, pin_offset, q_idler, q_sp
 from ..core.jit import KERNEL
 from ..ground.terrain import flat_ground
 from ..vehicle.parameters import equilibrium_arm_angle, pack, total_mass
-from .closed_track_jit import loop_rhs
+from .closed_track_jit import closed_rhs
 from .rhs import rhs
 
 
@@ -147,7 +147,7 @@ class ClosedStaticProblem(StaticProblem):
     method does not find reliably: the loop's cogging energy is not smooth)."""
 
     def __init__(self, vehicle, track, gravity, contact, geometry, loop, guides, soil=None):
-        from ..vehicle.closed_track import loop_pins
+        from ..vehicle.closed_track import closed_pins
         self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
         for k, v in (soil or {}).items():
             self.par[k] = v
@@ -170,7 +170,7 @@ class ClosedStaticProblem(StaticProblem):
         self.work = work_arrays(self.m, self.nw, self.n_links)
         self.diag = np.zeros(L.n_diag(self.nw, self.n_links))
         self.nq = L.n_coordinates(self.nw, self.n_links, closed=True)
-        self.pins, self.psi = loop_pins(geometry)
+        self.pins, self.psi = closed_pins(geometry)
         self.slide0 = geometry.slide
         self.weight = (total_mass(vehicle, track) + track["pin_mass"] + loop[L.LP_IDLER_MASS]) * gravity
 
@@ -190,18 +190,18 @@ class ClosedStaticProblem(StaticProblem):
     def residual(self, u):
         r = np.empty(u.size)
         arm_moment = np.empty(self.nw)
-        fx = _loop_residual(u, *self._args(), r, arm_moment)
+        fx = _closed_residual(u, *self._args(), r, arm_moment)
         return r, fx, arm_moment
 
     def jacobian(self, u, h=1e-7):
         J = np.empty((u.size, u.size))
-        _loop_jacobian(u, h, *self._args(), J)
+        _closed_jacobian(u, h, *self._args(), J)
         return J
 
 
 @njit(**KERNEL)
-def _loop_jacobian(u, h, phi, psi, m, w, diag, J):
-    """Central finite differences of _loop_residual (compiled: ~270 residuals a step)."""
+def _closed_jacobian(u, h, phi, psi, m, w, diag, J):
+    """Central finite differences of _closed_residual (compiled: ~270 residuals a step)."""
     n = u.shape[0]
     rp = np.empty(n)
     rm = np.empty(n)
@@ -209,9 +209,9 @@ def _loop_jacobian(u, h, phi, psi, m, w, diag, J):
     up = u.copy()
     for k in range(n):
         up[k] = u[k] + h
-        _loop_residual(up, phi, psi, m, w, diag, rp, am)
+        _closed_residual(up, phi, psi, m, w, diag, rp, am)
         up[k] = u[k] - h
-        _loop_residual(up, phi, psi, m, w, diag, rm, am)
+        _closed_residual(up, phi, psi, m, w, diag, rm, am)
         up[k] = u[k]
         for i in range(n):
             v = (rp[i] - rm[i]) / (2.0 * h)
@@ -219,8 +219,8 @@ def _loop_jacobian(u, h, phi, psi, m, w, diag, J):
 
 
 @njit(**KERNEL)
-def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
-    """The closed layout's generalised forces at rest (loop.loop_rhs fills w.genf) on the
+def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
+    """The closed layout's generalised forces at rest (loop.closed_rhs fills w.genf) on the
     unknowns into r (on the sprocket angle: its change, which holds it), each arm's moment
     about its pivot; returns the horizontal force."""
     nw = m.arms.shape[0]
@@ -237,7 +237,7 @@ def _loop_residual(u, phi, psi, m, w, diag, r, arm_moment):
     for k in range(2 * n):
         y[off + k] = u[4 + k]
     ydot = np.empty(y.shape[0])
-    loop_rhs(y, m, w, ydot, diag)
+    closed_rhs(y, m, w, ydot, diag)
     r[0] = w.genf[L.Q_Y]
     r[1] = w.genf[L.Q_PITCH]
     r[2] = w.genf[q_idler(nw, n)]

@@ -1,5 +1,5 @@
 """Equations of motion in reduced coordinates: chassis (x, y, pitch), arm angles
-relative to the chassis, free pins (layout.py). The revolute joints are built into
+relative to the chassis, free pins (model/core/indices.py). The revolute joints are built into
 the coordinates, so Eq. (9) becomes M(q) qdd = Q(q, qd) with an (3 + n_wheels)
 square block for chassis + arms, solved by its Schur complement (the arm block is
 diagonal), and a diagonal block for the pins.

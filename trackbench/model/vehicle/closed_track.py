@@ -196,7 +196,7 @@ def closed_geometry(v, tr, spr, idl, rol, explicit=frozenset()):
                           circles)
 
 
-def loop_pins(g):
+def closed_pins(g):
     """n_links pins on the taut loop (body frame), clockwise (front to rear along the
     ground, as the paper's track), and the sprocket angle that seats one of them."""
     from ..core import fixed_math as fm  # numba: loaded when first needed
@@ -234,7 +234,7 @@ def _check_rollers(tr, rol, circles):
             )
 
 
-def loop_vector(g, spr, idl, drive, contact_c, drawbar=None):
+def closed_vector(g, spr, idl, drive, contact_c, drawbar=None):
     """The LP_* vector of the kernels. contact_c: the viscous coefficient of pin-tooth
     contacts (N s/m; 0 = none); drawbar: the drawbar group (None: no drawbar)."""
     lp = np.zeros(L.N_LOOP)

@@ -175,7 +175,7 @@ def _pack_contact(par, contact):
 
 
 def pack(vehicle, track, gravity, contact=None):
-    """Scalar parameter vector ``par`` (see layout.P_*) and the body-point tables."""
+    """Scalar parameter vector ``par`` (see indices.P_*) and the body-point tables."""
     par = np.zeros(L.N_PAR)
     par[L.P_CHASSIS_MASS] = vehicle["chassis_mass"]
     par[L.P_CHASSIS_INERTIA] = vehicle["chassis_inertia"]

@@ -65,7 +65,7 @@ def after_acceptance(h, err, expo, fac_max, h_max):
 
 @njit(**BORROW)
 def finish_stats(stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi):
-    """The run's figures into stats (layout.S_*)."""
+    """The run's figures into stats (indices.S_*)."""
     stats[S_STATUS] = status
     stats[S_T_FINAL] = t
     stats[S_STEPS] = steps

@@ -29,7 +29,7 @@ from ...model.contact.gaps import (
 )
 from ...model.contact.laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ...model.core import fixed_math as fm
-from ...model.core.bundles import LoopEventWork
+from ...model.core.bundles import ClosedEventWork
 from ...model.core.indices import (
     G_REACH,
     K_CORNER_LINK,
@@ -61,7 +61,7 @@ from ...model.core.indices import (
 )
 from ...model.core.indices_jit import nq_of, q_idler, q_pin, q_sprocket
 from ...model.core.jit import BORROW, INLINE, KERNEL
-from ...model.dynamics.closed_track_jit import guide_offset, place_loop
+from ...model.dynamics.closed_track_jit import guide_offset, place_closed
 from ...model.ground.soil_jit import KINK_TOL, N_KINKS, soil_kink
 from ...model.vehicle.kinematics import body_offset, place, wheel_offset
 from ...model.vehicle.teeth_jit import pin_on_teeth, tooth_shape
@@ -70,8 +70,8 @@ from .hermite import coordinate, quintic_basis
 BISECTIONS = 24
 
 
-def _is_loop(ev):
-    return getattr(ev, "instance_class", None) is LoopEventWork
+def _is_closed(ev):
+    return getattr(ev, "instance_class", None) is ClosedEventWork
 
 
 @njit(**INLINE)
@@ -87,7 +87,7 @@ def _paper_pin_at(b, w, step, nq, m, n_links):
 
 
 @njit(**INLINE)
-def _loop_pin_at(b, w, step, nq, m, n_links):
+def _closed_pin_at(b, w, step, nq, m, n_links):
     """Position of pin row b of the closed loop along the step (row 0 is pin n_links, row
     n_links + 1 pin 1: the loop wraps round)."""
     if b == 0:
@@ -99,15 +99,15 @@ def _loop_pin_at(b, w, step, nq, m, n_links):
 
 
 def _pin_at(b, w, step, nq, m, n_links, ev):
-    """_paper_pin_at or _loop_pin_at by the layout (the type of ev): a paper-layout run
+    """_paper_pin_at or _closed_pin_at by the layout (the type of ev): a paper-layout run
     never compiles the closed layout's event code."""
     raise NotImplementedError("compiled only")
 
 
 @overload(_pin_at, jit_options=KERNEL)
 def _pin_at_impl(b, w, step, nq, m, n_links, ev):
-    if _is_loop(ev):
-        return lambda b, w, step, nq, m, n_links, ev: _loop_pin_at(b, w, step, nq, m, n_links)
+    if _is_closed(ev):
+        return lambda b, w, step, nq, m, n_links, ev: _closed_pin_at(b, w, step, nq, m, n_links)
     return lambda b, w, step, nq, m, n_links, ev: _paper_pin_at(b, w, step, nq, m, n_links)
 
 
@@ -118,10 +118,10 @@ def _place_ends(y0, y1, nq, m, ev):
 
 @overload(_place_ends, jit_options=KERNEL)
 def _place_ends_impl(y0, y1, nq, m, ev):
-    if _is_loop(ev):
+    if _is_closed(ev):
         def closed(y0, y1, nq, m, ev):
-            place_loop(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
-            place_loop(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm, ev.guides1)
+            place_closed(y0[:nq], m, ev.pins0, ev.wheels0, ev.arm, ev.guides0)
+            place_closed(y1[:nq], m, ev.pins1, ev.wheels1, ev.arm, ev.guides1)
         return closed
 
     def paper(y0, y1, nq, m, ev):
@@ -137,7 +137,7 @@ def _guide_at(j, w, step, nq, m, ev):
 
 @overload(_guide_at, jit_options=KERNEL)
 def _guide_at_impl(j, w, step, nq, m, ev):
-    if _is_loop(ev):
+    if _is_closed(ev):
         def closed(j, w, step, nq, m, ev):
             th = coordinate(w, step, Q_PITCH, nq)
             sl = coordinate(w, step, q_idler(m.arms.shape[0], ev.pins0.shape[0] - 1), nq)
@@ -154,7 +154,7 @@ def _guide_end(j, e, ev):
 
 @overload(_guide_end, jit_options=KERNEL)
 def _guide_end_impl(j, e, ev):
-    if _is_loop(ev):
+    if _is_closed(ev):
         def closed(j, e, ev):
             g = ev.guides0 if e == 0 else ev.guides1
             return g[j, 0], g[j, 1]
@@ -179,10 +179,10 @@ def _teeth_gap_at(b, t, step, nq, m, n_links, ev):
 
 @overload(_teeth_gap_at, jit_options=KERNEL)
 def _teeth_gap_at_impl(b, t, step, nq, m, n_links, ev):
-    if _is_loop(ev):
+    if _is_closed(ev):
         def closed(b, t, step, nq, m, n_links, ev):
             w = quintic_basis(t)
-            px, py = _loop_pin_at(b, w, step, nq, m, n_links)
+            px, py = _closed_pin_at(b, w, step, nq, m, n_links)
             q = (coordinate(w, step, Q_X, nq), coordinate(w, step, Q_Y, nq), coordinate(w, step, Q_PITCH, nq),
                  coordinate(w, step, q_sprocket(m.arms.shape[0], n_links), nq))
             return _teeth_gap(px, py, q, m.loop, tooth_shape(m.loop))
@@ -344,7 +344,7 @@ def _teeth_switch(step, nq, m, ev, best):
 
 @overload(_teeth_switch, jit_options=KERNEL)
 def _teeth_switch_impl(step, nq, m, ev, best):
-    if _is_loop(ev):
+    if _is_closed(ev):
         def closed(step, nq, m, ev, best):
             y0, _, y1, _, _ = step
             i_s = q_sprocket(m.arms.shape[0], ev.pins0.shape[0] - 1)
@@ -367,7 +367,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     """Smallest t in (0, 1] at which some candidate contact starts or ends along the
     step's interpolant - or, with the viscous law, reaches the end of its dashpot's ramp,
     a kink of the same kind, or on soft soil a pin crosses a kink of the soil's pressure
-    law (_soil_switch); 2.0 if none. ev: EventWork (the paper's layout) or LoopEventWork
+    law (_soil_switch); 2.0 if none. ev: EventWork (the paper's layout) or ClosedEventWork
     (the closed one: the idler, rollers and teeth as well)."""
     nq = nq_of(y0.shape[0])
     _place_ends(y0, y1, nq, m, ev)

@@ -15,7 +15,7 @@ from .continuation import soil_sinkage_guess, solve_static
 
 @dataclass
 class Equilibrium:
-    q: np.ndarray  # reduced coordinates (layout.py), chassis x = 0
+    q: np.ndarray  # reduced coordinates (model/core/indices.py), chassis x = 0
     phi0: np.ndarray  # torsion-bar free angles (rad)
     preload: np.ndarray  # torsion-bar torque on each arm at equilibrium (N m)
     wheel_load: np.ndarray  # vertical track force on each road wheel (N)
@@ -100,7 +100,7 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     return _balance(P, u, it)
 
 
-def solve_loop_equilibrium(
+def solve_closed_equilibrium(
     vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12, max_iter=60
 ):
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
