@@ -166,7 +166,7 @@ def test_thrust_against_slip_matches_wong_within_5_percent(slip, duration, since
     ],
 )
 def test_thrust_matches_wong_for_a_uniformly_loaded_track(slip, duration, since):
-    """The issue's form: Wong's closed form for a track of the same contact length, area and
+    """The textbook form: Wong's closed form for a track of the same contact length, area and
     weight under uniform pressure, within 5 %."""
     fig, f_wong, _, _ = _drawbar_run(slip, duration, since)
     assert fig["thrust"] == pytest.approx(f_wong, rel=0.05)

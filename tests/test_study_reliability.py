@@ -147,7 +147,7 @@ def dask_cluster(cwd, workers):
 
 
 def test_dask_workers_started_elsewhere_write_into_the_study_folder(tmp_path):
-    """The issue's case: relative results folder, workers started in another directory."""
+    """A relative results folder, workers started in another directory."""
     pytest.importorskip("dask.distributed")
     here, elsewhere = tmp_path / "study", tmp_path / "elsewhere"
     write_study(here, "dk")
