@@ -327,6 +327,26 @@ def fake_summary(folder):
     pd.DataFrame(rows).to_csv(folder / "summary.csv", index=False)
 
 
+def test_study_figure_tells_failed_runs_from_runs_not_run_yet(tmp_path, monkeypatch):
+    """A study stopped halfway: its pending runs are not called failed."""
+    fake_summary(tmp_path / "st")
+    df = pd.read_csv(tmp_path / "st" / "summary.csv")
+    df.loc[df.index[:2], "status"] = "pending"
+    df.to_csv(tmp_path / "st" / "summary.csv", index=False)
+    import matplotlib.axes
+
+    labels = []
+    plot = matplotlib.axes.Axes.plot
+
+    def spy(self, *args, **kw):
+        labels.append(kw.get("label"))
+        return plot(self, *args, **kw)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "plot", spy)
+    plot_study(tmp_path / "st", tmp_path / "out")
+    assert "failed run (1)" in labels and "not run yet (2)" in labels
+
+
 def test_plot_study_one_figure_per_axis(tmp_path):
     fake_summary(tmp_path / "st")
     df = pd.read_csv(tmp_path / "st" / "summary.csv")

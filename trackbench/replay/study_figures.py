@@ -165,9 +165,10 @@ def _x_of(df, axis, src):
     return col, False, col.map(where).astype(float).to_numpy(), np.arange(len(raw), dtype=float), raw
 
 
-def _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed):
+def _draw_panel(ax, df, cols, per_unit, groups, x_all, order, status):
     """Each column's runs as points and, per group, the line through the medians at each x;
-    failed runs as red crosses on the axis."""
+    failed runs as red crosses on the axis, runs not run yet as grey rings there."""
+    completed = status == "completed"
     for k, c in enumerate(cols):
         y = df[c].astype(float).to_numpy() / per_unit
         label = (
@@ -184,10 +185,14 @@ def _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed):
             )
             fin = np.isfinite(med)
             ax.plot(order[fin], med[fin], ls=ls, color=f"C{k}", lw=1.3, label=label if gi == 0 else None)
-    bad = ~completed & np.isfinite(x_all)
+    bad = (status == "failed") & np.isfinite(x_all)
     if bad.any():
         ax.plot(x_all[bad], np.zeros(int(bad.sum())), "x", color="red", ms=8, mew=2,
                 label=f"failed run ({int(bad.sum())})", clip_on=False)
+    todo = ~completed & (status != "failed") & np.isfinite(x_all)
+    if todo.any():
+        ax.plot(x_all[todo], np.zeros(int(todo.sum())), "o", mfc="none", color="0.5", ms=7,
+                label=f"not run yet ({int(todo.sum())})", clip_on=False)
     ax.grid(True, alpha=0.3)
 
 
@@ -227,8 +232,9 @@ def _note(axis, others, tied, grouped, too_many, spread):
     return note
 
 
-def _axis_figure(df, axis, axes, src, panels, completed, plt):
+def _axis_figure(df, axis, axes, src, panels, status, plt):
     """The figure of one grid axis (study_<axis>.png's content)."""
+    completed = status == "completed"
     col, numeric, x_all, order, raw = _x_of(df, axis, src)
     # axes zipped with this one (one value per x) are not others: they go with it
     valid = completed & np.isfinite(x_all)
@@ -246,7 +252,7 @@ def _axis_figure(df, axis, axes, src, panels, completed, plt):
         layout="constrained",
     )
     for ax, (ylabel, cols, per_unit) in zip(axs[:, 0], panels):
-        _draw_panel(ax, df, cols, per_unit, groups, x_all, order, completed)
+        _draw_panel(ax, df, cols, per_unit, groups, x_all, order, status)
         ax.set_ylabel(ylabel)
         _legend(ax, groups, plt)
     if not numeric:
@@ -304,8 +310,8 @@ def _panels(df):
 
 def plot_study(study_dir, out_dir):
     """A peak-force-against-parameter figure per grid axis (study_<axis>.png); returns the paths.
-    Completed runs only, failed runs are marked on the x axis. With other axes varying too:
-    one line per combination of their values (up to MAX_LINES; the line joins the medians of
+    Completed runs only; failed runs and runs not run yet are marked on the x axis. With other
+    axes varying too: one line per combination of their values (up to MAX_LINES; the line joins the medians of
     replicates), else every run a point and the line the median over them."""
     import pandas as pd
     plt = _plt()
@@ -317,10 +323,11 @@ def plot_study(study_dir, out_dir):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     panels = _panels(df)
-    completed = (df["status"] == "completed").to_numpy() if "status" in df.columns else np.ones(len(df), bool)
+    status = df["status"].astype(str).to_numpy() if "status" in df.columns else np.full(len(df), "completed")
+    completed = status == "completed"
     paths = []
     for axis in axes:
-        fig = _axis_figure(df, axis, axes, src, panels, completed, plt)
+        fig = _axis_figure(df, axis, axes, src, panels, status, plt)
         path = out / f"study_{axis.replace('.', '_').replace('/', '_')}.png"
         fig.savefig(path, dpi=DPI)
         plt.close(fig)
