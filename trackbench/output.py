@@ -76,7 +76,7 @@ def _motion(model, result, placed):
 
 
 def _energies(result, nq):
-    """The paper's balance and the work-based residual (model/energy.py), relative to E0."""
+    """The paper's balance and the work-based residual (model/dynamics/energy.py), relative to E0."""
     d, y = result.diag, result.y
     work, dissipated = y[:, 2 * nq + L.Y_WORK], y[:, 2 * nq + L.Y_DISSIPATED]
     kin, tors, tens = d[:, L.D_E_KINETIC], d[:, L.D_E_TORSION], d[:, L.D_E_TENSION]

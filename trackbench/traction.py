@@ -1,6 +1,6 @@
 """Drawbar-test figures of a run of the closed track on flat soft soil: the steady means of
 slip, thrust and drawbar pull, the contact the track makes, and Wong's closed form for a
-track under uniform pressure beside them (model/soil.py). The benchmark, the tests and the
+track under uniform pressure beside them (model/ground/soil.py). The benchmark, the tests and the
 study plot read a run through these functions, so each figure is computed one way.
 
 On flat soil the soil's pressure on a pin acts along the surface normal (vertical), so the

@@ -1,7 +1,8 @@
 """Contact geometry, written once: where a point lies relative to a link, a pin's wedge or
 a ground segment, and which ground segment a pin presses on. The force kernels
-(kernels.py) and the event location (solvers/events.py) both decide "in contact or not"
-through these functions, so a located onset is an onset of the force law.
+(track_contacts.py, ground/ground_contact.py) and the event location
+(solvers/common/events.py) both decide "in contact or not" through these functions, so a
+located onset is an onset of the force law.
 
 Conventions (docs/model.md): link b runs from pin b to pin b+1 with unit direction t and
 length l (Work.lk); its inner normal (towards the road wheels) is (t_y, -t_x).

@@ -15,7 +15,7 @@ Coefficients (docs/model.md, "Beyond the paper: dissipation"):
   the depth d_r (as ADAMS' IMPACT function) so the force does not jump at first touch.
 
 This module holds the laws' names, codes and coefficients (plain Python: scenario
-validation needs them without a compiler); the compiled law is contact_force.py.
+validation needs them without a compiler); the compiled law is laws_jit.py.
 """
 
 import math

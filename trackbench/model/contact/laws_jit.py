@@ -1,4 +1,4 @@
-"""The normal-force law of every penalty contact, compiled (contact_laws.py has the
+"""The normal-force law of every penalty contact, compiled (laws.py has the
 formulas, their sources and the codes)."""
 
 import math
@@ -50,6 +50,6 @@ def bristle(limit, k, c, d, v_t):
     to an anchor on the ground) is stretched by d and slides at v_t: -k d - c v_t, never
     beyond the Coulomb force mu p = k limit. In stick the pin rides on the spring, whose
     frequency an explicit step resolves, where the regularised law's slope mu p / v_eps
-    is a stiff damper; the anchor slips (model/grip.py) where the spring exceeds mu p."""
+    is a stiff damper; the anchor slips (model/ground/grip.py) where the spring exceeds mu p."""
     f_max = k * limit
     return min(max(-k * d - c * v_t, -f_max), f_max)

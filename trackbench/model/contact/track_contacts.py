@@ -2,10 +2,10 @@
 and ground-track penalty contacts (Eqs. 2-7, Figs. 3-6 and the contact cases of docs/model.md),
 and the candidate lists that keep the contact search away from far-apart pairs.
 
-Every kernel takes the bundles of model/bundles.py: ``m`` (ModelArrays: parameters,
+Every kernel takes the bundles of model/core/bundles.py: ``m`` (ModelArrays: parameters,
 ground, candidate lists), ``w`` (Work: pin and wheel kinematics in, forces out) and
 ``diag`` (indices.D_*). The geometry of each contact (which side, which wedge, which
-segment) is model/gaps.py.
+segment) is model/contact/gaps.py.
 """
 
 import math

@@ -34,7 +34,7 @@ ModelArrays = namedtuple("ModelArrays", [
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
-# forces out (model/kernels.py track_loads).
+# forces out (model/dynamics/track_loads.py).
 Work = namedtuple("Work", [
     "apos",       # (n_pins, 2) pin positions, track ends included
     "avel",       # (n_pins, 2) pin velocities
@@ -122,7 +122,7 @@ LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of ClosedWork.extra
 ARM_D = ARM_COLS                   # column of ClosedWork.extra: the diagonal mass
 
 
-# Scratch of the event location (solvers/events.py): the configuration at both ends of
+# Scratch of the event location (solvers/common/events.py): the configuration at both ends of
 # a rejected step; the closed layout's adds its idler and rollers.
 EventWork = namedtuple("EventWork", ["pins0", "pins1", "wheels0", "wheels1", "arm"])
 ClosedEventWork = namedtuple("ClosedEventWork", list(EventWork._fields) + ["guides0", "guides1"])

@@ -22,13 +22,13 @@ copy of row n_links, so that link b still joins rows b and b+1 (link 0 closes th
 After the pin coordinates come the sprocket's angle relative to the chassis
 (q_sprocket) and the idler carrier's slide along its guide (q_idler).
 
-Absolute state ``z`` of the "lee" solver (model/absolute.py)::
+Absolute state ``z`` of the "lee" solver (model/dynamics/absolute.py)::
 
     z[Z_X], z[Z_Y], z[Z_PITCH]              chassis mass centre and pitch
     z[z_arm(i) + ZA_X / ZA_Y / ZA_BETA]     arm i: road-wheel centre and absolute arm angle
     z[z_pin(nw) + 2*(b-1) + k]              free pin b, coordinate k
 
-Everything here is a plain constant or a one-line function (model/index.py compiles the
+Everything here is a plain constant or a one-line function (model/core/indices_jit.py compiles the
 functions for the kernels; this module stays free of numba, so that validating a
 scenario or a study file does not load the compiler), and no kernel writes a bare index
 into a shared array.
@@ -189,7 +189,7 @@ LP_IDLER_MASS = 12       # idler wheel + carrier (kg)
 LP_PRELOAD = 13          # tensioner force at slide 0 (N)
 LP_TENSIONER_STIFFNESS = 14  # (N/m)
 LP_TENSIONER_DAMPING = 15    # (N s/m)
-LP_DRIVE_KIND = 16       # DRIVE_* code (model/drive.py)
+LP_DRIVE_KIND = 16       # DRIVE_* code (model/vehicle/drive.py)
 LP_DRIVE_TORQUE = 17     # torque of the torque drive (N m, forward positive)
 LP_TARGET = 18           # speed of the speed drive (m/s)
 LP_GAIN_P = 19           # PI gains of the speed drive (N m per m/s, N m per m)
@@ -199,7 +199,7 @@ LP_TRAVEL = 22           # the idler's slide stays within +-travel (m)
 LP_FLANK_ANGLE = 23      # flare of the teeth's flanks, the pressure angle (rad)
 LP_CURVE = 24  # torque-speed curve: LP_CURVE_POINTS pairs (sprocket speed rad/s, torque N m) after it
 LP_CURVE_POINTS = 16
-# the drawbar on the chassis (model/drive.py): a constant load and the towing rig
+# the drawbar on the chassis (model/vehicle/drive.py): a constant load and the towing rig
 LP_DRAWBAR_LOAD = LP_CURVE + 1 + 2 * LP_CURVE_POINTS   # rearward horizontal force at the hitch (N)
 LP_HITCH_X = LP_DRAWBAR_LOAD + 1   # body point of the hitch (m)
 LP_HITCH_Y = LP_DRAWBAR_LOAD + 2
@@ -207,7 +207,7 @@ LP_RIG_SLIP = LP_DRAWBAR_LOAD + 3  # slip the towing rig sets (0: no rig)
 LP_RIG_DAMPING = LP_DRAWBAR_LOAD + 4   # dashpot of the rig's carriage on the hitch (N s/m)
 N_LOOP = LP_RIG_DAMPING + 1
 
-# drive.kind codes (model/drive.py)
+# drive.kind codes (model/vehicle/drive.py)
 DRIVE_NONE, DRIVE_TORQUE, DRIVE_SPEED = 0, 1, 2
 DRIVES = {"none": DRIVE_NONE, "torque": DRIVE_TORQUE, "speed": DRIVE_SPEED}
 
@@ -251,7 +251,7 @@ P_K_WHEEL = 12           # k_w
 P_K_GROUND = 13          # k_g
 P_GRAVITY = 14
 P_SKIN = 15              # neighbour-list margin (m); results do not depend on it
-# contact laws (model/contact_laws.py) and dampers; the paper: linear, no damping
+# contact laws (model/contact/laws.py) and dampers; the paper: linear, no damping
 P_CONTACT_LAW = 16       # LAW_* code
 P_CONTACT_EXPONENT = 17  # n of the power law
 P_CONTACT_DAMPING = 18   # DAMPING_* code
@@ -261,10 +261,10 @@ P_RESTITUTION_FACTOR = 21  # chi of the restitution-based laws
 P_DAMPING_RAMP = 22      # d_r (m)
 P_MIN_APPROACH = 23      # approach speed below which v0 counts as this (m/s)
 P_LINK_DAMPING = 24      # axial dashpot of every link (N s/m)
-P_CONTACT_GEOMETRY = 25   # GEOMETRY_* code (contact_laws.py)
+P_CONTACT_GEOMETRY = 25   # GEOMETRY_* code (contact/laws.py)
 P_FRICTION = 26          # Coulomb coefficient mu between ground and track
 P_FRICTION_VELOCITY = 27  # regularising speed of the friction law (m/s)
-# soft soil (model/soil_force.py; 0 in P_SOIL: the rigid ground of the paper)
+# soft soil (model/ground/soil_jit.py; 0 in P_SOIL: the rigid ground of the paper)
 P_SOIL = 28              # 1: pins press on Bekker soil instead of the ground pads
 P_SOIL_N = 29            # Bekker exponent n
 P_SOIL_K = 30            # k_c / b + k_phi (N/m^(n+2))
@@ -275,13 +275,13 @@ P_RUT_DX = 34            # cell width (m)
 P_SOIL_COHESION = 35     # cohesion x the pin's area, c A (N)
 P_SOIL_TAN_PHI = 36      # tan of the soil's friction angle
 P_SOIL_SHEAR_K = 37      # shear deformation modulus K of Janosi-Hanamoto (m)
-# the bristle friction law (contact_laws.FRICTION_BRISTLE): spring and dashpot per ground contact
+# the bristle friction law (contact/laws.FRICTION_BRISTLE): spring and dashpot per ground contact
 P_FRICTION_LAW = 38      # FRICTION_* code
 P_BRISTLE_K = 39         # tangential stiffness k_t (N/m)
 P_BRISTLE_C = 40         # its dashpot, 2 zeta sqrt(k_t m_pin) (N s/m)
 N_PAR = 41
 
-# --- columns of Work.grip: the bristle friction at the last evaluation (model/grip.py) ---------
+# --- columns of Work.grip: the bristle friction at the last evaluation (model/ground/grip.py) ---------
 G_LIMIT = 0              # slip limit mu p / k_t (m)
 G_TX = 1                 # the ground's unit tangent
 G_TY = 2

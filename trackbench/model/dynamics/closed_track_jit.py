@@ -10,7 +10,7 @@ I_s (omega + psi')^2 / 2); the idler (wheel + carrier, mass m_i) is a point mass
 c + R(theta)(g0 + s u); the rollers turn on chassis-fixed axes (their masses are part of
 the chassis'). Like an arm, the sprocket and the idler each add one row to the mass matrix
 that couples with the chassis alone, so the chassis block is solved by the same Schur
-complement as the paper's (model/reduced.py).
+complement as the paper's (model/dynamics/reduced.py).
 
 The drive's torque acts between chassis and sprocket, the tensioner's force between
 chassis and carrier: each does work on its own coordinate only. Their power, the power of
@@ -182,7 +182,7 @@ def _closed_positions(q, qd, m, w):
 @njit(**INLINE)
 def _guide_contacts(w, m, diag, mem):
     """The idler and the rollers against the track from inside, frictionless, as the road
-    wheels (kernels.round_on_track, the same law); their forces into w.fguide."""
+    wheels (track_contacts.round_on_track, the same law); their forces into w.fguide."""
     par = m.par
     law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
@@ -200,7 +200,7 @@ def _guide_contacts(w, m, diag, mem):
 
 @njit(**INLINE)
 def _teeth(w, m, diag):
-    """Every pin against the sprocket's tooth profile (model/sprocket.py): the force on the
+    """Every pin against the sprocket's tooth profile (model/vehicle/teeth_jit.py): the force on the
     pin pushes it out of the profile, the sprocket takes the opposite force through the
     pin's centre (into w.spr: force and torque about the axis)."""
     par, lp, spr, apos, avel, fpin = m.par, m.loop, w.spr, w.apos, w.avel, w.fpin

@@ -89,7 +89,7 @@ def _loads_at_rest(q, m, w, diag):
     The solver's own right-hand side computes them: one compiled copy of the contact code."""
     nq = q.shape[0]
     y = np.zeros(n_state(nq))
-    for k in range(nq):  # loops, not slice assignments: see solvers/arrays.py
+    for k in range(nq):  # loops, not slice assignments: see solvers/common/arrays.py
         y[k] = q[k]
     ydot = np.empty(n_state(nq))
     rhs(y, m, w, ydot, diag)
@@ -220,7 +220,7 @@ def _closed_jacobian(u, h, phi, psi, m, w, diag, J):
 
 @njit(**KERNEL)
 def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
-    """The closed layout's generalised forces at rest (loop.closed_rhs fills w.genf) on the
+    """The closed layout's generalised forces at rest (closed_track_jit.closed_rhs fills w.genf) on the
     unknowns into r (on the sprocket angle: its change, which holds it), each arm's moment
     about its pivot; returns the horizontal force."""
     nw = m.arms.shape[0]

@@ -14,7 +14,7 @@ def _closed(w):
 
 
 def rhs(y, m, w, ydot, diag):
-    """ydot = f(y): reduced.reduced_rhs (paper's layout) or loop.closed_rhs (closed)."""
+    """ydot = f(y): reduced.reduced_rhs (paper's layout) or closed_track_jit.closed_rhs (closed)."""
     if isinstance(w, ClosedWork):
         return closed_rhs(y, m, w, ydot, diag)
     return reduced_rhs(y, m, w, ydot, diag)

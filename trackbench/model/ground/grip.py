@@ -4,7 +4,7 @@ that stays where the pin touched down while the bristle carries less than mu p, 
 along while the pin slides (the force then at mu p). The anchor moves only after an accepted
 step (remember_grip), so a rejected step leaves no trace, and it moves so that the force at the
 step's end stays what the step ended with (the next step starts from that derivative); within a
-step the force is the spring's and the dashpot's, capped at mu p (contact_force.bristle), a
+step the force is the spring's and the dashpot's, capped at mu p (laws_jit.bristle), a
 continuous function of the state. A pin on two segments at once (the paper's geometry at a
 concave corner) holds its bristle on the first; the regularised law acts on the other."""
 
@@ -80,7 +80,7 @@ def remember_grip(m, w):
             anchor[b, 1] = w.apos[b, 1]
         else:
             k, f = m.par[P_BRISTLE_K], grip[b, G_FORCE]
-            if abs(f) >= k * limit:      # capped (contact_force.bristle returns k limit exactly)
+            if abs(f) >= k * limit:      # capped (laws_jit.bristle returns k limit exactly)
                 d = bristle_stretch(b, w.apos, anchor, grip[b, G_TX], grip[b, G_TY])
                 slide = d - (-f - m.par[P_BRISTLE_C] * grip[b, G_SPEED]) / k
                 anchor[b, 0] += slide * grip[b, G_TX]

@@ -54,14 +54,14 @@ def paper_track():
         "wheel_stiffness": 1.0e8,  # k_w, Eq. (4) (N/m)
         "ground_stiffness": 1.0e8,  # k_g, Eq. (6) (N/m)
         "link_damping": 0.0,  # axial dashpot parallel to each link spring (N s/m)
-        "layout": "paper",  # "paper": ends fixed to the chassis; "closed": a loop (closed.py)
+        "layout": "paper",  # "paper": ends fixed to the chassis; "closed": a loop (vehicle/closed_track.py)
         "tension": 80000.0,  # closed layout: static tension the derived link count and preload aim at (N)
         "width": 0.5,  # b: soft soil's pressure acts over this width (m; the paper gives none)
     }
 
 
 def closed_defaults():
-    """Sprocket, idler, rollers and drive of the closed layout (model/closed.py derives the
+    """Sprocket, idler, rollers and drive of the closed layout (model/vehicle/closed_track.py derives the
     values given as 0 from the paper's vehicle; docs/model.md lists them)."""
     return {
         "sprocket": {
@@ -152,7 +152,7 @@ def wheel_centres_body(vehicle):
 
 
 def _pack_contact(par, contact):
-    """The contact law's codes and coefficients (model/contact_laws.py) into par."""
+    """The contact law's codes and coefficients (model/contact/laws.py) into par."""
     par[L.P_CONTACT_LAW] = LAWS[contact["law"]]
     par[L.P_CONTACT_EXPONENT] = contact["exponent"] if contact["law"] == "power" else 1.0
     damping = DAMPINGS[contact["damping"]]

@@ -1,5 +1,5 @@
 """The sprocket's tooth geometry in plain Python (scenario validation and the drawings use
-it without the compiler; model/sprocket.py compiles the two formulas for the contact
+it without the compiler; model/vehicle/teeth_jit.py compiles the two formulas for the contact
 kernel, whose docstring describes the profile)."""
 
 import math

@@ -9,8 +9,8 @@ bisection, so that the retried step ends right after the kink.
 
 A pair is "valid" where its force law applies (foot on the link or segment, the convex
 wedge, the segment a pin may press on) and in contact where it is valid and its gap is
-positive: the same tests as the force kernels, from model/gaps.py, on points placed by
-model/kinematics.py.
+positive: the same tests as the force kernels, from model/contact/gaps.py, on points placed by
+model/vehicle/kinematics.py.
 """
 
 import math

@@ -140,7 +140,7 @@ def _up(peaks, k, v, t, t_switch):
 @njit(**BORROW)
 def update_peaks(peaks, t, diag, vx, work, e_ref, r_ref, at_switch):
     """e_ref, r_ref: energy balance and residual at t = 0; at_switch: this step was
-    shortened to end just after a located contact switch (solvers/events.py)."""
+    shortened to end just after a located contact switch (solvers/common/events.py)."""
     ts = peaks[PK_SWITCH, 1]  # the last sample at a switch before this one (see _up)
     nw = peaks.shape[0] - PK_WHEEL_FY
     if peaks[PK_FIRST_COMPRESSION, 0] == 0.0 and diag[D_MIN_TENSION] < 0.0:

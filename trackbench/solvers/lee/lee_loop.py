@@ -1,5 +1,5 @@
 """The "lee" solver's compiled time loop: per step the procedure of the paper's section
-4.3 (Fig. 7), on the absolute coordinates of model/absolute.py.
+4.3 (Fig. 7), on the absolute coordinates of model/dynamics/absolute.py.
 
 1. Integrate Eq. (9) over the step with the RKN pair, lambda linear from lam0 (known)
    to lam1; iterate lam1 by Eq. (15) with the position error Eq. (12) at t + h until
@@ -7,7 +7,7 @@
    stage) at each iteration. Non-convergence rejects the step (h / 2).
 2. Embedded error estimate; reject (and shrink h) or accept and pick the next h. A
    rejected step in which a contact starts or ends is retried to end just after it
-   (solvers/events.py, on the step's ends in reduced coordinates), as in the reduced solver.
+   (solvers/common/events.py, on the step's ends in reduced coordinates), as in the reduced solver.
 3. Velocity level: with the stage forces of 1 held, iterate lambda with Eq. (13) to
    max |Phi_q qd| <= position_tol / h; this sets qd(t + h) of the chassis and arms.
 4. Acceleration level: with the forces at t + h, iterate lambda with Eq. (14) to
@@ -25,9 +25,9 @@ then forces and the acceleration level at the sample, so diag means what reduced
 puts there. The chassis acceleration in diag (samples and peaks) and the joint forces come
 from a copy of the multipliers iterated on to DIAG_ACC_TOL (below).
 
-Every array the loop uses is allocated by the Python side (lee.py) and arrives bundled:
+Every array the loop uses is allocated by the Python side (lee_run.py) and arrives bundled:
 ``lw`` (LeeWork, lee_work.py), ``lout`` (LeeOutputs), ``ls`` (LeeSettings), the rest as in
-the reduced solver (solvers/reduced.py). Scalars that live from step to step sit in
+the reduced solver (solvers/rk/rk_loop.py). Scalars that live from step to step sit in
 ``lw.sc`` under the SC_* names.
 """
 

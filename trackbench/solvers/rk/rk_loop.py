@@ -2,9 +2,9 @@
 adaptive step size, the whole time loop compiled. Returns output samples on a regular
 grid (Hermite interpolation between accepted steps) and peaks over every step.
 
-The loop's scratch is allocated by the Python side (rk.py) and arrives bundled:
+The loop's scratch is allocated by the Python side (rk_run.py) and arrives bundled:
 ``ctl`` (base.Control), ``tab`` (tableau.TableauArrays), ``m``/``w``/``ev``
-(model/bundles.py), ``lw`` (ClosedWork below), ``out`` (base.Outputs)."""
+(model/core/bundles.py), ``lw`` (RkWork below: the time loop's scratch), ``out`` (base.Outputs)."""
 
 import math
 from collections import namedtuple
@@ -33,7 +33,7 @@ from ..common.events import first_contact_switch
 from ..common.hermite import hermite_second_order
 from ..common.monitor import energy_balance, energy_residual, init_peaks, update_peaks
 
-ClosedWork = namedtuple("ClosedWork", [
+RkWork = namedtuple("RkWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
     "y",      # (ny,) state at the step start
     "y_new",  # (ny,) state at the step end
@@ -54,7 +54,7 @@ EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
 
 def loop_arrays(stages, ny, n_diag, n_pins):
     end = EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, N_GRIP), np.nan))
-    return ClosedWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
+    return RkWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
                     np.empty(ny), np.empty(ny), np.empty(n_diag), end)
 
 
