@@ -11,7 +11,7 @@ from .atomic import atomic_path
 from .model.core import indices as L
 from .model.dynamics.energy import paper_balance, work_residual
 from .model.vehicle.kinematics import place_samples
-from .output_closed import _closed_attrs, _closed_layout, _soil
+from .output_closed import closed_attrs, closed_layout_vars, soil_vars
 from .status import Result
 from .variables import WH, K, P, T
 from .variables import var as _var
@@ -215,11 +215,11 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     v.update(_energies(result, model.nq))
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
-        v.update(_closed_layout(model, result, scenario, placed))
+        v.update(closed_layout_vars(model, result, scenario, placed))
     rut_x = None
     if model.par[L.P_SOIL] != 0.0:
-        soil_vars, rut_x = _soil(model, result, ground, placed)
-        v.update(soil_vars)
+        sv, rut_x = soil_vars(model, result, ground, placed)
+        v.update(sv)
     for name, (dims, data, units, text) in result.extra.items():
         v[name] = _var(dims, data, units, text)
     coords = {
@@ -242,7 +242,7 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
             "1",
             "track link number (joins pins b and b+1; link 0 joins the last pin and pin 1)",
         )
-        attrs.update(_closed_attrs(scenario))
+        attrs.update(closed_attrs(scenario))
     if rut_x is not None:
         coords["rut_x"] = _var(("rut_x",), rut_x, "m", "x of the soil's memory cells (centres)")
     return xr.Dataset(v, coords=coords, attrs=attrs)

@@ -48,7 +48,7 @@ def _span_tensions(model, q, pins, tension, g):
     return out
 
 
-def _closed_layout(model, result, scenario, placed):
+def closed_layout_vars(model, result, scenario, placed):
     """The closed layout's own variables: sprocket, idler, drive, span tensions."""
     from .assembly import closed_parts
 
@@ -118,7 +118,7 @@ def _closed_layout(model, result, scenario, placed):
     return v
 
 
-def _soil(model, result, ground, placed):
+def soil_vars(model, result, ground, placed):
     """Soft soil: each pin's sinkage below the soil surface (the ground's profile, along the
     normal of the segment under it), the rut at the end of the run (the plastic sinkage each
     cell of the soil's memory keeps)."""
@@ -183,7 +183,7 @@ def _soil(model, result, ground, placed):
     }, x[lo:hi]
 
 
-def _closed_attrs(scenario):
+def closed_attrs(scenario):
     from .assembly import closed_parts
 
     g, lp, guides = closed_parts(scenario)

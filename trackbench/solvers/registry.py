@@ -12,7 +12,7 @@ from dataclasses import dataclass
 class SolverEntry:
     name: str  # the value of `solver`
     module: str  # where its run(scenario, model, y0) -> RunResult lives
-    methods: tuple  # the values `method` may take with it ("" = it has no choice)
+    methods: tuple  # the values `method` chooses among (empty: the solver's own pair, no choice)
     closed_track: bool  # whether it integrates the closed track
     summary: str
 
@@ -30,14 +30,14 @@ SOLVERS = {
         SolverEntry(
             "lee",
             "trackbench.solvers.lee.lee_run",
-            ("dop853", "dopri5"),
+            (),
             False,
             "the paper's method: absolute coordinates, Lee's accelerated iteration, RKN6(4)",
         ),
     )
 }
 # every method any solver takes (scenario validation's allowed values)
-METHODS = tuple(sorted({m for e in SOLVERS.values() for m in e.methods if m}))
+METHODS = tuple(sorted({m for e in SOLVERS.values() for m in e.methods}))
 
 
 def run_function(name):

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core import indices as L
-from .parameters import equilibrium_arm_angle, pivots
+from .parameters import wheel_centres_body
 from .teeth import pitch_radius as _pitch_radius
 from .track_path import closed_loop, closed_track, link_count
 
@@ -55,12 +55,6 @@ class ClosedGeometry:
                 "sprocket.tip_radius": self.tip_radius, "idler.preload": self.preload}
 
 
-def _wheel_centres(v):
-    from ..core import fixed_math as fm  # numba: loaded when first needed
-    phi = equilibrium_arm_angle(v)
-    return pivots(v) + v["arm_length"] * np.array([fm.cos(phi), fm.sin(phi)])
-
-
 def _ends(v, spr):
     front, rear = np.array(v["front_track_end"], float), np.array(v["rear_track_end"], float)
     return (rear, front) if spr["position"] == "rear" else (front, rear)
@@ -82,7 +76,7 @@ def _circles(v, tr, idl, rol, sprocket, rp, idler_at):
     def wrap(r):
         return fm.hypot(r + hw, 0.5 * tr["link_length"])
 
-    c = [(x, y, wrap(v["wheel_radius"])) for x, y in _wheel_centres(v)]
+    c = [(x, y, wrap(v["wheel_radius"])) for x, y in wheel_centres_body(v)]
     c.append((sprocket[0], sprocket[1], rp))
     c.append((idler_at[0], idler_at[1], wrap(idl["radius"])))
     c += [(x, y, wrap(rol["radius"])) for x, y in rol["positions"]]

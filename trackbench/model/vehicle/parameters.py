@@ -145,10 +145,12 @@ def equilibrium_arm_angle(vehicle):
 
 
 def wheel_centres_body(vehicle):
-    """Wheel centres in the chassis frame at the initial equilibrium, for the scenario's
-    checks (the C library's sines: they decide no result, and need no compiler)."""
+    """Wheel centres in the chassis frame at the initial equilibrium: the scenario's checks,
+    the closed track's geometry and the equilibrium's start."""
+    from ..core import fixed_math as fm  # numba: loaded when first needed
+
     phi = equilibrium_arm_angle(vehicle)
-    return pivots(vehicle) + vehicle["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
+    return pivots(vehicle) + vehicle["arm_length"] * np.array([fm.cos(phi), fm.sin(phi)])
 
 
 def _pack_contact(par, contact):

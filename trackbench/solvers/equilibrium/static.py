@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...model.core import fixed_math as fm
 from ...model.core import indices as L
 from ...model.dynamics.equilibrium import ClosedStaticProblem, StaticProblem
+from ...model.vehicle.parameters import wheel_centres_body
 from ...model.vehicle.track_path import initial_track
 from .continuation import soil_sinkage_guess, solve_static
 
@@ -85,9 +85,7 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
     hg = P.par[L.P_PAD_GROUND]
     # start: wheels resting on the track, the track on the ground, chassis level
-    wcb = P.arms[:, [L.ARMS_PX, L.ARMS_PY]] + P.par[L.P_ARM_LENGTH] * np.array(
-        [fm.vcos(P.phi), fm.vsin(P.phi)]
-    )
+    wcb = wheel_centres_body(vehicle)
     yc = -wcb[:, 1].min() + rho + hg
     ends_w = P.ends + [0.0, yc]
     pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
