@@ -25,7 +25,7 @@ def simulate(scenario: Scenario, progress=None):
         raise ScenarioError(str(e)) from None
     model = Model(scenario, eq, ground)
     y0 = initial_state(scenario, eq)
-    run_solver = run_function(scenario["solver"])
+    run_solver = run_function(scenario["solver"], scenario["method"])
     from .output import build_dataset
     t_solve = time.perf_counter()
     result = run_solver(scenario, model, y0)

@@ -15,6 +15,10 @@ class SolverEntry:
     methods: tuple  # the values `method` chooses among (empty: the solver's own pair, no choice)
     closed_track: bool  # whether it integrates the closed track
     summary: str
+    method_modules: tuple = ()  # (method, module) pairs run by a module other than `module`
+
+    def module_for(self, method):
+        return dict(self.method_modules).get(method, self.module)
 
 
 SOLVERS = {
@@ -23,9 +27,15 @@ SOLVERS = {
         SolverEntry(
             "reduced",
             "trackbench.solvers.rk.rk_run",
-            ("dop853", "dopri5"),
+            ("dop853", "dopri5", "ark436l2sa", "ark548l2sa"),
             True,
-            "reduced coordinates, embedded explicit Runge-Kutta pairs (DOP853, DOPRI5)",
+            "reduced coordinates, embedded explicit Runge-Kutta pairs (DOP853, DOPRI5) or additive "
+            "(IMEX) pairs with the pins' block Jacobian as the implicit part (ARK4(3)6L[2]SA, "
+            "ARK5(4)8L[2]SA)",
+            (
+                ("ark436l2sa", "trackbench.solvers.imex.ark_run"),
+                ("ark548l2sa", "trackbench.solvers.imex.ark_run"),
+            ),
         ),
         SolverEntry(
             "lee",
@@ -40,6 +50,6 @@ SOLVERS = {
 METHODS = tuple(sorted({m for e in SOLVERS.values() for m in e.methods}))
 
 
-def run_function(name):
-    """The run(scenario, model, y0) of the solver called `name`."""
-    return importlib.import_module(SOLVERS[name].module).run
+def run_function(name, method=None):
+    """The run(scenario, model, y0) of the solver called `name` with `method`."""
+    return importlib.import_module(SOLVERS[name].module_for(method)).run

@@ -13,13 +13,12 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step, remember_onsets
-from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_GRIP, Q_X, S_E0, Y_WORK
+from ...model.core.indices import Q_X, Y_WORK
 from ...model.core.indices_jit import nq_of
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import has_ground_memory, remember_ground
-from ...status import NAN, SUCCESSFUL
-from ..common.arrays import copy_into, set_row
+from ...status import SUCCESSFUL
 from ..common.control import (
     FAC_MAX,
     after_acceptance,
@@ -30,8 +29,8 @@ from ..common.control import (
     loop_start,
 )
 from ..common.events import first_contact_switch
-from ..common.hermite import hermite_second_order
-from ..common.monitor import energy_balance, energy_residual, init_peaks, update_peaks
+from ..common.monitor import update_peaks
+from ..common.stepping import accepted_status, end_of_step, keep_end, loop_first, samples
 
 RkWork = namedtuple("RkWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
@@ -45,27 +44,10 @@ RkWork = namedtuple("RkWork", [
     "end",    # EndOfStep: the ground's state at the end of the accepted step
 ])
 
-# What the soil's and the bristles' memories are moved from after an accepted step (Work's
-# fields of the same names, at the step's end), kept while the output samples inside the step
-# are evaluated: the step was integrated with the memories as they were before it, and so are
-# its samples.
-EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
-
 
 def loop_arrays(stages, ny, n_diag, n_pins):
-    end = EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, N_GRIP), np.nan))
     return RkWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
-                    np.empty(ny), np.empty(ny), np.empty(n_diag), end)
-
-
-@njit(**INLINE)
-def _keep_end(w, end):
-    for b in range(w.sink.shape[0]):
-        end.apos[b, 0] = w.apos[b, 0]
-        end.apos[b, 1] = w.apos[b, 1]
-        end.sink[b] = w.sink[b]
-        for k in range(N_GRIP):
-            end.grip[b, k] = w.grip[b, k]
+                  np.empty(ny), np.empty(ny), np.empty(n_diag), end_of_step(n_pins))
 
 
 @njit(**INLINE)
@@ -113,28 +95,6 @@ def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
     return abs(h) * math.sqrt(s5 / n)
 
 
-@njit(**BORROW)
-def _start(y0, m, w, lw, out):
-    """t = 0: the first derivative (row 0 of K), the energy references, the first sample.
-    Returns (status, e_ref, r_ref)."""
-    ny = y0.shape[0]
-    nq = nq_of(ny)
-    copy_into(lw.y, 0, y0)
-    rhs(lw.y, m, w, lw.K[0], lw.diag)
-    e_ref = energy_balance(lw.diag)
-    r_ref = energy_residual(lw.diag, lw.y[2 * nq + Y_WORK])
-    out.stats[S_E0] = e_ref - lw.diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
-    init_peaks(out.peaks)
-    update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[2 * nq + Y_WORK], e_ref, r_ref, False)
-    remember_onsets(m, w)
-    remember_ground(m, w)
-    set_row(out.y, 0, lw.y)
-    set_row(out.diag, 0, lw.diag)
-    if lw.diag[D_STATUS] != 0.0:
-        return int(lw.diag[D_STATUS]), e_ref, r_ref
-    return SUCCESSFUL, e_ref, r_ref
-
-
 @njit(**INLINE)
 def _stages(h, A, b, m, w, y, K, ys, y_new, diag):
     """One step of the pair from y: stages into K, the new state into y_new and its
@@ -147,35 +107,6 @@ def _stages(h, A, b, m, w, y, K, ys, y_new, diag):
     rhs(y_new, m, w, K[s], diag)
 
 
-@njit(**INLINE)
-def _samples(t, h, n_out, dt_out, m, w, lw, out):
-    """Output samples in (t, t + h] by Hermite interpolation; returns the new sample count."""
-    y, K, y_new, ys, fs = lw.y, lw.K, lw.y_new, lw.ys, lw.fs
-    out_y, out_diag = out.y, out.diag
-    nq = nq_of(y.shape[0])
-    s = K.shape[0] - 1
-    t_new = t + h
-    while n_out < out_y.shape[0] and n_out * dt_out <= t_new * (1.0 + 1e-12):
-        theta = min(1.0, (n_out * dt_out - t) / h)
-        hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
-        set_row(out_y, n_out, ys)
-        rhs(ys, m, w, fs, out_diag[n_out])
-        n_out += 1
-    return n_out
-
-
-@njit(**INLINE)
-def _accepted_status(y_new, diag):
-    """NAN for a state that diverged, unless the evaluation found why (diag's status)."""
-    status = SUCCESSFUL
-    for k in range(y_new.shape[0]):
-        if not math.isfinite(y_new[k]):
-            status = NAN
-    if diag[D_STATUS] != 0.0:
-        status = int(diag[D_STATUS])
-    return status
-
-
 @njit(**BORROW)
 def integrate(y0, ctl, tab, m, w, ev, lw, out):
     A, b, e, e3, expo = tab.A, tab.b, tab.e, tab.e3, tab.expo
@@ -185,7 +116,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     ny = y0.shape[0]
     nq = nq_of(ny)
     s = b.shape[0]
-    status, e_ref, r_ref = _start(y0, m, w, lw, out)
+    status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
     h = min(ctl.h0, h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
@@ -218,13 +149,13 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
                 continue
         t_new = t + h
         steps, h_lo, h_hi = counted(h, steps, h_lo, h_hi)
-        status = _accepted_status(y_new, diag)
+        status = accepted_status(y_new, diag)
         update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
         at_switch = False
         remember_onsets(m, w)
         if memory:
-            _keep_end(w, lw.end)
-        n_new = _samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
+            keep_end(w, lw.end)
+        n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
         if memory:
             remember_ground(m, lw.end)  # from the accepted end state, after the samples inside the step
         n_rhs += n_new - n_out

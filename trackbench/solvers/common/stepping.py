@@ -1,0 +1,104 @@
+"""What the compiled time loops of the reduced state share around their steps: the start at
+t = 0, the output samples inside an accepted step (Hermite interpolation between the step's
+ends), the status of an accepted state, and the ground's state at a step's end kept while
+the samples are evaluated. A loop's scratch bundle has the fields y, y_new, ys, fs, diag and
+K (row 0: f at the step's start; last row: f at its end)."""
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+from ...model.contact.onsets import remember_onsets
+from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_GRIP, Q_X, S_E0, Y_WORK
+from ...model.core.indices_jit import nq_of
+from ...model.core.jit import BORROW, INLINE
+from ...model.dynamics.rhs import rhs
+from ...model.ground.memory import remember_ground
+from ...status import NAN, SUCCESSFUL
+from .arrays import copy_into, set_row
+from .hermite import hermite_second_order
+from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
+
+# What the soil's and the bristles' memories are moved from after an accepted step (Work's
+# fields of the same names, at the step's end), kept while the output samples inside the step
+# are evaluated: the step was integrated with the memories as they were before it, and so are
+# its samples.
+EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
+
+
+def end_of_step(n_pins):
+    return EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, N_GRIP), np.nan))
+
+
+@njit(**INLINE)
+def keep_end(w, end):
+    for b in range(w.sink.shape[0]):
+        end.apos[b, 0] = w.apos[b, 0]
+        end.apos[b, 1] = w.apos[b, 1]
+        end.sink[b] = w.sink[b]
+        for k in range(N_GRIP):
+            end.grip[b, k] = w.grip[b, k]
+
+
+@njit(**BORROW)
+def loop_first(y0, m, w, lw, out):
+    """t = 0: the first derivative (row 0 of K), the energy references, the first sample.
+    Returns (status, e_ref, r_ref)."""
+    ny = y0.shape[0]
+    nq = nq_of(ny)
+    copy_into(lw.y, 0, y0)
+    rhs(lw.y, m, w, lw.K[0], lw.diag)
+    e_ref = energy_balance(lw.diag)
+    r_ref = energy_residual(lw.diag, lw.y[2 * nq + Y_WORK])
+    out.stats[S_E0] = e_ref - lw.diag[D_E_GRAVITY]  # kinetic + elastic: gravity potential measured from t = 0
+    init_peaks(out.peaks)
+    update_peaks(out.peaks, 0.0, lw.diag, lw.y[nq + Q_X], lw.y[2 * nq + Y_WORK], e_ref, r_ref, False)
+    remember_onsets(m, w)
+    remember_ground(m, w)
+    set_row(out.y, 0, lw.y)
+    set_row(out.diag, 0, lw.diag)
+    if lw.diag[D_STATUS] != 0.0:
+        return int(lw.diag[D_STATUS]), e_ref, r_ref
+    return SUCCESSFUL, e_ref, r_ref
+
+
+@njit(**INLINE)
+def samples(t, h, n_out, dt_out, m, w, lw, out):
+    """Output samples in (t, t + h] by Hermite interpolation; returns the new sample count."""
+    y, K, y_new, ys, fs = lw.y, lw.K, lw.y_new, lw.ys, lw.fs
+    out_y, out_diag = out.y, out.diag
+    nq = nq_of(y.shape[0])
+    s = K.shape[0] - 1
+    t_new = t + h
+    while n_out < out_y.shape[0] and n_out * dt_out <= t_new * (1.0 + 1e-12):
+        theta = min(1.0, (n_out * dt_out - t) / h)
+        hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
+        set_row(out_y, n_out, ys)
+        rhs(ys, m, w, fs, out_diag[n_out])
+        n_out += 1
+    return n_out
+
+
+@njit(**INLINE)
+def accepted_status(y_new, diag):
+    """NAN for a state that diverged, unless the evaluation found why (diag's status)."""
+    status = SUCCESSFUL
+    for k in range(y_new.shape[0]):
+        if not math.isfinite(y_new[k]):
+            status = NAN
+    if diag[D_STATUS] != 0.0:
+        status = int(diag[D_STATUS])
+    return status
+
+
+@njit(**INLINE)
+def error_norm(y, y_new, er, rtol, atol, n):
+    """RMS norm of an error estimate er over the first n components (q, qd): the
+    linearly implicit methods' (the explicit pairs' own, rk_loop.py, folds in h)."""
+    s = 0.0
+    for k in range(n):
+        sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
+        s += (er[k] / sc) ** 2
+    return math.sqrt(s / n)

@@ -1,0 +1,1 @@
+"""Additive Runge-Kutta (IMEX) methods: validated tables of Kennedy & Carpenter's pairs."""
