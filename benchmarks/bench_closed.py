@@ -2,19 +2,28 @@
 Prints figures; asserts nothing. Takes several minutes.
 
     python benchmarks/bench_closed.py            # everything
-    python benchmarks/bench_closed.py drive      # one part: rest, drive, profiles, traction, step, cost
+    python benchmarks/bench_closed.py drive      # one part: rest, drive, profiles, traction, step, cost,
+                                                 # precision, spread
+    python benchmarks/bench_closed.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
 """
 
 import sys
 import time
 
 import numpy as np
+import work_precision
 from side_by_side import best_walls
 
 import trackbench as tb
 
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6}
 REPEATS = 3
+# step()'s run (the paper's step, 10 m/s, speed drive) with each friction law: the precision models
+STEP = {**CLOSED, "drive.kind": "speed", "drive.target": 10.0}
+MODELS = {
+    "closed, regularised friction": STEP,
+    "closed, bristle friction": {**STEP, "contact.friction_law": "bristle"},
+}
 
 
 def rest():
@@ -217,8 +226,37 @@ def cost():
         )
 
 
-PARTS = {"rest": rest, "drive": drive, "profiles": profiles, "traction": traction, "step": step, "cost": cost}
+def precision(vs=None, repeats=REPEATS):
+    """Work against precision of MODELS (benchmarks/work_precision.py): cost, and deviation from
+    dopri5 at 1e-11, of each (method, tolerance) of `vs` (default: the registry's methods at
+    work_precision.TOLERANCES)."""
+    for name, model in MODELS.items():
+        work_precision.precision(name, model, vs or work_precision.variants(), repeats)
+
+
+def spread(vs=None):
+    """The spread of MODELS' peaks over tolerances and nudges, for each (method, tolerance)."""
+    for name, model in MODELS.items():
+        work_precision.spread(name, model, vs or work_precision.variants())
+
+
+PARTS = {
+    "rest": rest,
+    "drive": drive,
+    "profiles": profiles,
+    "traction": traction,
+    "step": step,
+    "cost": cost,
+    "precision": precision,
+    "spread": spread,
+}
 
 if __name__ == "__main__":
-    for name in sys.argv[1:] or PARTS:
-        PARTS[name]()
+    names, vs, repeats = work_precision.command_line(sys.argv[1:], PARTS)
+    for name in names:
+        if name == "precision":
+            precision(vs, repeats)
+        elif name == "spread":
+            spread(vs)
+        else:
+            PARTS[name]()

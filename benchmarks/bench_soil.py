@@ -1,17 +1,26 @@
 """Soft soil: cost of paper_step on LETE sand against the rigid ground (side by side, best of
 REPEATS), the closed, speed-driven track on each soil, and the drawbar test on LETE sand:
 thrust against slip beside Wong's closed form, with the paper's links and with stiff ones.
+Also the work against precision of the closed step on LETE sand (benchmarks/work_precision.py).
 Prints figures; asserts nothing.
 
-    python benchmarks/bench_soil.py
+    python benchmarks/bench_soil.py           # everything
+    python benchmarks/bench_soil.py soils     # one part: cost, soils, slips, stiff_slips, precision, spread
+    python benchmarks/bench_soil.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
 """
 
+import sys
+
+import work_precision
+from bench_closed import STEP
 from side_by_side import best_walls
 
 import trackbench as tb
 from trackbench.traction import pressure_effect, run_soil, steady, wong
 
 REPEATS = 3
+# bench_closed.py's step() run (the paper's step, 10 m/s, speed drive) on LETE sand
+MODELS = {"closed, LETE sand": {**STEP, "terrain.soil": "lete_sand"}}
 
 
 def cost():
@@ -110,8 +119,34 @@ def slip_curve(slips=(0.05, 0.1, 0.2, 0.3, 0.4, 0.5), link_stiffness=None, durat
         )
 
 
+def precision(vs=None, repeats=REPEATS):
+    """Work against precision of MODELS: cost, and deviation from dopri5 at 1e-11, of each
+    (method, tolerance) of `vs` (default: the registry's methods at work_precision.TOLERANCES)."""
+    for name, model in MODELS.items():
+        work_precision.precision(name, model, vs or work_precision.variants(), repeats)
+
+
+def spread(vs=None):
+    """The spread of MODELS' peaks over tolerances and nudges, for each (method, tolerance)."""
+    for name, model in MODELS.items():
+        work_precision.spread(name, model, vs or work_precision.variants())
+
+
+PARTS = {
+    "cost": cost,
+    "soils": soils,
+    "slips": slip_curve,
+    "stiff_slips": lambda: slip_curve(link_stiffness=8e7),  # Wong's track is inextensible: test_drawbar's
+    "precision": precision,
+    "spread": spread,
+}
+
 if __name__ == "__main__":
-    cost()
-    soils()
-    slip_curve()
-    slip_curve(link_stiffness=8e7)  # Wong's track is inextensible: tests/test_drawbar.py's links
+    names, vs, repeats = work_precision.command_line(sys.argv[1:], PARTS)
+    for name in names:
+        if name == "precision":
+            precision(vs, repeats)
+        elif name == "spread":
+            spread(vs)
+        else:
+            PARTS[name]()
