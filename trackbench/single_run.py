@@ -60,6 +60,11 @@ def _energy_line(ds, s):
     return f"  energy balance error              {err:.4f} % (paper: < 0.06 %){tail}"
 
 
+def _integrator(attrs):
+    """The solver, its method and tolerance, as the run's attributes name them."""
+    return f"{attrs['solver']} {attrs['method']} at tolerance {attrs['tolerance']:g}"
+
+
 def format_summary(ds, path=None):
     from .output import summary_numbers
     from .quantities import BY_NAME as q
@@ -104,7 +109,8 @@ def format_summary(ds, path=None):
     ]
     lines += [
         _energy_line(ds, s),
-        f"  steps {a['steps']} (+{a['rejected_steps']} rejected), wall time {a['wall_time']:.3f} s",
+        f"  {_integrator(a)}: steps {a['steps']} (+{a['rejected_steps']} rejected), wall time "
+        f"{a['wall_time']:.3f} s",
     ]
     if shown(compression.name) == shown(compression.name):  # a link went into compression
         lines.append(
