@@ -100,6 +100,7 @@ PLAIN = [
     "trackbench.model.contact.laws",
     "trackbench.model.ground.soil",
     "trackbench.model.ground.terrain",
+    "trackbench.model.ground.rough",
     "trackbench.model.vehicle.teeth",
     "trackbench.model.vehicle.parameters",
     "trackbench.model.vehicle.closed_track",
@@ -107,6 +108,7 @@ PLAIN = [
     "trackbench.model.core.indices",
     "trackbench.scenario",
     "trackbench.solvers.registry",
+    "trackbench.ride_metrics",
 ]
 
 
@@ -134,6 +136,7 @@ def test_plain_modules_never_import_numba():
         ("teeth", "teeth_jit"),
         ("indices", "indices_jit"),
         ("closed_track", "closed_track_jit"),
+        ("ride_metrics", "ride_metrics_jit"),
     ],
 )
 def test_plain_and_compiled_twins_are_named_alike(plain, compiled):
