@@ -362,7 +362,7 @@ def _write(tmp_path, text):
 def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     import io
 
-    from trackbench.study.runner import _Progress
+    from trackbench.study.progress import StudyProgress
 
     runs = [
         {"run_id": "a1", "status": "completed"},
@@ -370,7 +370,7 @@ def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
         {"run_id": "c3", "status": "completed"},
     ]
     log = io.StringIO()
-    p = _Progress(3, 1, stream=log, workers=2)
+    p = StudyProgress(3, 1, stream=log, workers=2)
     for r in runs:
         p.update(r)
     p.close()
@@ -382,7 +382,7 @@ def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
         "(done 1  failed 1  running 1  of 3, ETA 0 s)"
     )
     term = io.StringIO()
-    p = _Progress(3, 0, stream=term, workers=2, terminal=True)
+    p = StudyProgress(3, 0, stream=term, workers=2, terminal=True)
     p.running(2)
     p.update(runs[0])
     p.close()
@@ -399,18 +399,18 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
     import io
     import json
 
-    from trackbench.study.runner import _Progress
+    from trackbench.study.progress import StudyProgress
 
     flag = tmp_path / "flag.json"
     flag.write_text(json.dumps({"compiling": True, "seconds": 0.0}))
     term = io.StringIO()
-    p = _Progress(3, 0, stream=term, workers=2, terminal=True, flag=flag)
+    p = StudyProgress(3, 0, stream=term, workers=2, terminal=True, flag=flag)
     p.bar.refresh()
     assert "compiling the model" in re.sub(r"\x1b\[[0-9;?]*[a-zA-Z]", "", term.getvalue())
     p.close()
     flag.write_text(json.dumps({"compiling": False, "seconds": 3600.0}))
     log = io.StringIO()
-    p = _Progress(3, 0, stream=log, workers=2, flag=flag)
+    p = StudyProgress(3, 0, stream=log, workers=2, flag=flag)
     p.update({"run_id": "a1", "status": "completed"})
     lines = log.getvalue().splitlines()
     assert lines[1].startswith("(the workers waited 3600 s for the model to compile")

@@ -13,9 +13,11 @@ from .simulate import simulate  # noqa: E402  (light until called)
 _LAZY = {
     "open_study": ("study.summary", "open_study"),
     "open_study_dataset": ("study.summary", "open_study_dataset"),
+    "open_limits": ("study.limits", "open_limits"),
 }
 
-__all__ = ["Scenario", "ScenarioError", "simulate", "open_study", "open_study_dataset", "__version__"]
+__all__ = ["Scenario", "ScenarioError", "simulate", "open_study", "open_study_dataset", "open_limits",
+           "__version__"]
 
 
 def __getattr__(name):

@@ -195,7 +195,7 @@ def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or it
 
 @study_app.command("status", cls=_Command)
 def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
-    """Show how many runs are done, failed and pending."""
+    """Show how many runs are done, failed and pending (and how far a [search] is)."""
     from .study.runner import count, other_runs, others_note, status_counts
     from .study.summary import missing_folder
     study = _study_folder_or_fail(file)[0] if file.is_dir() else _load_study_or_fail(file)
@@ -204,6 +204,10 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
             f"study {study.name}: {count(len(study.runs), 'run')}, all pending: {missing_folder(study)}"
         )
         return
+    search = ""
+    if study.search is not None:   # replayed first: it adds the runs the search asks for next
+        from .study.limits import search_state
+        search = search_state(study)
     counts, df = status_counts(study)
     kept = others_note(len(other_runs(study)))
     typer.echo(
@@ -211,6 +215,8 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
         f"{counts['failed']} failed, "
         f"{counts['pending']} pending ({study.output}){'; ' + kept if kept else ''}"
     )
+    if search:
+        typer.echo(search)
     for _, r in df[df.status == "failed"].iterrows():
         typer.echo(f"  failed {r.run_id}: {r.status_message}")
 

@@ -231,6 +231,19 @@ def summary_columns(n_wheels, times=True, features=()):
     return out
 
 
+def shape_of(scenarios):
+    """(most road wheels, the models that add quantities: "closed", "soil") of resolved scenarios:
+    the columns a study's summary has."""
+    wheels, features = 0, set()
+    for sc in scenarios:
+        wheels = max(wheels, int(sc["vehicle"]["n_wheels"]))
+        if sc["track"].get("layout") == "closed":
+            features.add("closed")
+        if sc["terrain"].get("soil", "rigid") != "rigid":
+            features.add("soil")
+    return wheels, features
+
+
 def peak_columns(n_wheels, features=()):
     """The peaks' and means' columns (those with replicate statistics)."""
     return [c for q in PEAKS if not q.needs or q.needs in features for c in q.columns(n_wheels)]

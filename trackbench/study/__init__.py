@@ -3,7 +3,7 @@ The parts load on first use (study file validation needs none of the heavy libra
 
 _LAZY = {
     "run_study": "runner", "StudyError": "spec", "load_study": "spec", "StudyLocked": "store",
-    "open_run": "summary", "open_study": "summary", "open_study_dataset": "summary",
+    "open_run": "summary", "open_limits": "limits", "open_study": "summary", "open_study_dataset": "summary",
 }
 
 __all__ = sorted(_LAZY)

@@ -17,6 +17,7 @@ import uuid
 from collections import deque
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
+from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
@@ -372,14 +373,13 @@ def _fill(pool, fresh, retry, running, workers):
     return False
 
 
-def run_dask(tasks, workers=2, scheduler=None, notify=None):
-    """Yield (task, record) as runs finish, on a dask.distributed cluster (a LocalCluster of
-    ``workers`` processes when no scheduler address is given). A worker that dies is dask's to
-    handle: the scheduler runs its task elsewhere, up to its allowed-failures (set to
-    MAX_ATTEMPTS - 1 on a LocalCluster), then the future raises KilledWorker."""
+@contextmanager
+def dask_client(workers=2, scheduler=None):
+    """A dask.distributed Client: of the scheduler at ``scheduler``, else of a LocalCluster of
+    ``workers`` processes (a worker that dies: the scheduler runs its task elsewhere, up to its
+    allowed-failures, set to MAX_ATTEMPTS - 1, then the future raises KilledWorker)."""
     import dask
     from dask.distributed import Client, LocalCluster
-    from dask.distributed import as_completed as dask_completed
     cluster = None
     if scheduler:
         try:
@@ -394,20 +394,32 @@ def run_dask(tasks, workers=2, scheduler=None, notify=None):
                                    dashboard_address=None)
         client = Client(cluster)
     try:
-        futures = {}
-        for t in tasks:
-            t = _attempt(t, 1)
-            futures[client.submit(execute_run, t, pure=False, key=f"trackbench-run-{t['run_id']}")] = t
-        for fut in dask_completed(list(futures)):
-            task = futures[fut]
-            try:
-                yield task, fut.result()
-            except Exception as e:
-                yield task, crashed(task, e)
+        yield client
     finally:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+def run_dask(tasks, workers=2, scheduler=None, notify=None, client=None):
+    """Yield (task, record) as runs finish, on a dask.distributed cluster: ``client``'s, else
+    one of dask_client(workers, scheduler) for these tasks. A run whose worker died for good
+    is recorded as crashed."""
+    if client is None:
+        with dask_client(workers, scheduler) as client:
+            yield from run_dask(tasks, notify=notify, client=client)
+        return
+    from dask.distributed import as_completed as dask_completed
+    futures = {}
+    for t in tasks:
+        t = _attempt(t, 1)
+        futures[client.submit(execute_run, t, pure=False, key=f"trackbench-run-{t['run_id']}")] = t
+    for fut in dask_completed(list(futures)):
+        task = futures[fut]
+        try:
+            yield task, fut.result()
+        except Exception as e:
+            yield task, crashed(task, e)
 
 
 def check_arguments(workers, executor, scheduler, storage):

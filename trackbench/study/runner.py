@@ -6,12 +6,13 @@
 import os
 import re
 import socket
-import sys
 import time
+from contextlib import closing
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import executors, store, warming
+from .progress import StudyProgress
 from .spec import Study, StudyError, load_study, resolved_toml
 from .summary import format_table, replicate_frame, summary_frame, write_summary
 
@@ -27,6 +28,8 @@ class Outcome:
     elapsed: float = 0.0
     summary_error: str = ""                         # why summary.csv could not be written
     others: int = 0                                 # run folders of no run of this study (kept)
+    limits: object = None                           # with [search]: limits.csv's DataFrame
+    search_state: str = ""                          # with [search]: its state in one line
 
     def counts(self):
         """(failed, not run) over the study's runs: the summary's view, plus the runs failed in
@@ -67,6 +70,8 @@ def manifest(study):
         "replicates": study.replicates,
         "storage": study.storage,
         "param_names": study.param_names,
+        "search": study.search.as_dict() if study.search is not None else None,
+        "points": study.points,
         "runs": [
             {
                 "run_id": r.run_id,
@@ -128,11 +133,13 @@ def check_output(study):
         )
 
 
-def plan(study, force=False):
-    """(tasks to run, ids already completed); each task stores its files as study.storage says."""
+def plan(study, force=False, runs=None, ran=()):
+    """(tasks to run, ids already completed) of ``runs`` (default: all the study's), each task
+    storing its files as study.storage says; ``force`` reruns completed runs, but not those in
+    ``ran`` (run by this invocation already)."""
     tasks, done = [], []
-    for run in study.runs:
-        if not force and store.is_completed(study.output, run.run_id):
+    for run in study.runs if runs is None else runs:
+        if run.run_id in ran or (not force and store.is_completed(study.output, run.run_id)):
             done.append(run.run_id)
             continue
         tasks.append({"run_id": run.run_id, "output": str(study.output), "scenario": run.scenario,
@@ -140,105 +147,6 @@ def plan(study, force=False):
                       "meta": {"study": study.name, "index": run.index, "variant": run.variant,
                                "replicate": run.replicate, "params": run.params}})
     return tasks, done
-
-
-class _Progress:
-    """A live rich progress bar on a terminal (done, failed, running, elapsed, ETA); one plain
-    line per finished run otherwise (a log, a pipe, CI)."""
-
-    def __init__(self, total, skipped, quiet=False, stream=None, workers=1, terminal=None, flag=None):
-        from rich.console import Console
-        self.console = Console(file=stream or sys.stderr, force_terminal=terminal)
-        self.console.soft_wrap = not self.console.is_terminal   # a log keeps one line per run, however long
-        self.total, self.done, self.failed, self.workers, self.in_flight = total, 0, 0, workers, None
-        self.quiet, self.t0, self.flag, self.compiled = quiet, time.perf_counter(), flag, 0.0
-        self.bar = None
-        if not quiet and self.console.is_terminal and total:
-            from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
-
-            self.bar = Progress(
-                TextColumn("[bold]{task.description}"),
-                BarColumn(),
-                _counts_column(self),
-                TimeElapsedColumn(),
-                TextColumn("ETA"),
-                TimeRemainingColumn(),
-                console=self.console,
-            )
-            self.task = self.bar.add_task("runs", total=total, counts=self._counts())
-            self.bar.start()
-        elif not quiet:
-            self.console.print(f"{total} runs to do, {skipped} already completed", highlight=False)
-
-    def _running(self):
-        left = self.total - self.done - self.failed
-        return min(left, self.workers if self.in_flight is None else self.in_flight)
-
-    def _counts(self):
-        return f"done {self.done}  failed {self.failed}  running {self._running()}  of {self.total}"
-
-    def running(self, n):
-        """The executor's count of runs in flight (without it: one per worker)."""
-        self.in_flight = n
-        if self.bar is not None:
-            self.bar.update(self.task, counts=self._counts())
-
-    def compiling(self):
-        """(compiling now, seconds compiled so far) from the fork server's flag file."""
-        import json
-        try:
-            said = json.loads(self.flag.read_text())
-        except (OSError, ValueError, AttributeError):
-            return False, self.compiled
-        self.compiled = max(self.compiled, float(said.get("seconds", 0.0)))
-        return bool(said.get("compiling")), self.compiled
-
-    def update(self, rec):
-        if rec["status"] == "completed":
-            self.done += 1
-        else:
-            self.failed += 1
-        if self.bar is not None:
-            self.bar.update(self.task, advance=1, counts=self._counts())
-        elif not self.quiet:
-            n = self.done + self.failed
-            _, compiled = self.compiling()
-            if n == 1 and compiled > 0.0:
-                self.console.print(
-                    f"(the workers waited {compiled:.0f} s for the model to compile: once per "
-                    "machine and version; later studies load it from the cache)",
-                    highlight=False,
-                )
-            el = max(
-                time.perf_counter() - self.t0 - compiled, 0.0
-            )  # the compiling is not what every run takes
-            eta = el / n * (self.total - n)
-            msg = "" if rec["status"] == "completed" else f": {rec.get('status_message', '')}"
-            self.console.print(f"[{n}/{self.total}] {rec['run_id']} {rec['status']}{msg}  ({self._counts()}, "
-                               f"ETA {eta:.0f} s)", highlight=False, markup=False)
-
-    def note(self, text):
-        if not self.quiet:
-            self.console.print(text, highlight=False, markup=False)
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.stop()
-
-
-def _counts_column(progress):
-    """The bar's counts; while the fork server compiles the model, that instead (the workers
-    wait for it: "running" would say otherwise)."""
-    from rich.progress import TextColumn
-    from rich.text import Text
-
-    class Counts(TextColumn):
-        def render(self, task):
-            if progress.compiling()[0]:
-                return Text("compiling the model (once, 1-2 min)", style="yellow")
-            return super().render(task)
-
-    return Counts("{task.fields[counts]}")
 
 
 def run_study(path, workers=2, executor="local", scheduler=None, force=False, output=None,
@@ -255,34 +163,78 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.clean_tmp(study.output)
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
-        tasks, done = plan(study, force)
-        if tasks:  # they load while this process sets up
-            executors.start_workers(
-                executor, scheduler, warm=warming.warm_kinds(t["scenario"] for t in tasks)
-            )
-        out.skipped = len(done)
-        progress = _Progress(len(tasks), len(done), quiet, workers=workers, flag=warming.compile_flag())
-        if executor == "dask":
-            stream = executors.run_dask(tasks, workers, scheduler, notify=progress.note)
-        else:
-            stream = executors.run_local(tasks, workers, notify=progress.note, on_running=progress.running)
+        waves = _Waves(study, out, force, (executor, workers, scheduler), quiet)
         try:
-            if tasks:
-                for task, rec in stream:
-                    rec = confirm(task, rec)
-                    out.ran += 1
-                    if rec["status"] != "completed":
-                        out.failed.append(task["run_id"])
-                    progress.update(rec)
+            if study.search is None:
+                waves(study.runs)
+            else:
+                from .limits import run_search
+                run_search(study, waves, waves.search)
         finally:
-            stream.close()
-            progress.close()
+            waves.close()
             warming.compile_flag().unlink(missing_ok=True)
             store.clean_tmp(study.output)  # what killed workers left half-written
             _summarise(study, out)
             out.others = len(other_runs(study))
     out.elapsed = time.perf_counter() - t0
     return out
+
+
+class _Waves:
+    """Runs a study's runs in waves (a plain study: one; a search: its scan, then each round of
+    bisection) on one executor: a dask cluster started for the first wave serves the rest, the
+    progress counts across them, and --force reruns a run once."""
+
+    def __init__(self, study, out, force, how, quiet):
+        from contextlib import ExitStack
+        self.study, self.out, self.force, self.how, self.quiet = study, out, force, how, quiet
+        self.progress, self.client, self.ran, self.line = None, None, set(), None
+        self.stack = ExitStack()
+
+    def __call__(self, runs):
+        """Run those of ``runs`` that are not completed (all with --force), one wave."""
+        executor, workers, scheduler = self.how
+        if self.study.search is not None:   # the runs the search has asked for so far
+            store.write_json(self.study.output / "runs.json", manifest(self.study))
+        tasks, done = plan(self.study, self.force, runs, self.ran)
+        self.out.skipped += len(done)
+        if tasks and not self.ran:  # they load while this process sets up
+            warm = warming.warm_kinds(t["scenario"] for t in tasks)
+            executors.start_workers(executor, scheduler, warm=warm)
+        if self.progress is None:
+            self.progress = StudyProgress(len(tasks), len(done), self.quiet, workers=workers,
+                                          flag=warming.compile_flag(), line=self.line)
+        else:
+            self.progress.more(len(tasks), len(done))
+        if not tasks:
+            return
+        self.ran.update(t["run_id"] for t in tasks)
+        if executor == "dask" and self.client is None:
+            self.client = self.stack.enter_context(executors.dask_client(workers, scheduler))
+        if executor == "dask":
+            stream = executors.run_dask(tasks, notify=self.progress.note, client=self.client)
+        else:
+            stream = executors.run_local(tasks, workers, notify=self.progress.note,
+                                         on_running=self.progress.running)
+        with closing(stream):
+            for task, rec in stream:
+                rec = confirm(task, rec)
+                self.out.ran += 1
+                if rec["status"] != "completed":
+                    self.out.failed.append(task["run_id"])
+                self.progress.update(rec)
+
+    def search(self, text):
+        self.line = text
+        if self.progress is not None:
+            self.progress.search(text)
+
+    def close(self):
+        try:
+            self.stack.close()
+        finally:
+            if self.progress is not None:
+                self.progress.close()
 
 
 def _prepare(path, workers, executor, scheduler, output, storage):
@@ -297,9 +249,13 @@ def _prepare(path, workers, executor, scheduler, output, storage):
 
 
 def _summarise(study, out):
-    """Write the summary files; when they cannot be written the frames are still returned and
-    the reason kept (the study then does not count as done)."""
+    """Write the summary files (and limits.csv of a search); when they cannot be written the
+    frames are still returned and the reason kept (the study then does not count as done)."""
     try:
+        if study.search is not None:   # first: its replay adds the runs a resumed search asks next
+            from .limits import write_limits
+            out.limits, out.search_state = write_limits(study)
+            store.write_json(study.output / "runs.json", manifest(study))
         out.summary, out.replicates = write_summary(study)
     except OSError as e:
         out.summary_error = executors.failure_reason(e, study.output)
@@ -378,7 +334,8 @@ def other_runs(study):
 
 
 def status_counts(study):
-    """{'completed': n, 'failed': n, 'pending': n} from the runs' run.json."""
+    """{'completed': n, 'failed': n, 'pending': n} from the runs' run.json (of a search: the
+    runs it has asked for so far)."""
     df = summary_frame(study)
     return {s: int((df.status == s).sum()) for s in ("completed", "failed", "pending")}, df
 
@@ -396,6 +353,9 @@ def report(outcome):
     )
     if outcome.summary_error:
         text += f" NOT WRITTEN: {outcome.summary_error}"
+    if outcome.limits is not None:
+        text += (f"\n\n{outcome.limits.to_string(index=False, float_format=lambda x: f'{x:.6g}', na_rep='-')}"
+                 f"\n{outcome.search_state}\nlimits: {s.output}/limits.csv")
     if outcome.others:
         text += f"\n{others_note(outcome.others, f'{s.output}/runs')}, not in the summary"
     return text

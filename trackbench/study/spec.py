@@ -5,6 +5,7 @@
     [grid]      cartesian axes: name = [values] | {start, stop, step} | {start, stop, num}
     [[zip]]     axes varied together (equal lengths), crossed with [grid]
     [[runs]]    explicit runs: each a table of overrides on top of [scenario]
+    [search]    one parameter searched for a limit at every point of the rest (search.py)
 
 Every error is a ``StudyError`` with a one-line message naming the file and the culprit.
 """
@@ -21,7 +22,7 @@ from pathlib import Path
 from ..scenario import Scenario, ScenarioError, parameter_names
 from .runid import run_id
 
-TOP_KEYS = ("study", "scenario", "grid", "zip", "runs")
+TOP_KEYS = ("study", "scenario", "grid", "zip", "runs", "search")
 STUDY_KEYS = ("name", "description", "output", "replicates", "storage")
 RANGE_KEYS = ("start", "stop", "step", "num")
 REPLICATE_PERTURBATION = 1e-9  # m
@@ -57,6 +58,9 @@ class Study:
     runs: list = field(default_factory=list)
     param_names: list = field(default_factory=list)
     storage: str = "full"  # how the runs' files are stored (trackbench/storage.py)
+    search: object = None  # the [search] table (search.SearchSpec) or None
+    points: list = field(default_factory=list)     # with [search]: the grid points searched, in order
+    base_scenario: object = field(default=None, repr=False, compare=False)  # the Scenario runs start from
 
     @property
     def runs_dir(self):
@@ -286,39 +290,80 @@ def load_study(path, output=None):
     if len(variants) * reps > MAX_RUNS:
         raise StudyError(f"{path}: the study has {len(variants) * reps} runs; at most {MAX_RUNS}")
     study = Study(name=name, description=desc, source=path, output=Path(output or out), replicates=reps,
-                  base=base.to_dict(), axes=axes, zips=zips, explicit=explicit, storage=_storage(path, meta))
+                  base=base.to_dict(), axes=axes, zips=zips, explicit=explicit, storage=_storage(path, meta),
+                  base_scenario=base)
+    pairs = list(enumerate(variants))
+    if "search" in doc:
+        pairs = _search_pairs(study, doc["search"], variants, path)
     names = []
-    for v in variants:
+    for _, v in pairs:
         names += [n for n in v if n not in names]
     if reps > 1:
         names += [n for n in ("seed",) if n not in names]
     study.param_names = names
     seen = {}
-    for vi, over in enumerate(variants):
-        try:
-            sc = base.with_overrides({**over, "name": name})
-        except ScenarioError as e:
-            desc_v = ", ".join(f"{k} = {_param_value(x)}" for k, x in over.items()) or "the base scenario"
-            raise StudyError(f"{path}: run {vi + 1} ({desc_v}): {e}") from None
+    for vi, over in pairs:
         for r in range(reps):
-            d = sc.to_dict()
-            params = {k: _param_value(x) for k, x in over.items()}
-            if reps > 1:
-                d["seed"] = r + 1
-                if d["perturbation"] == 0.0:
-                    d["perturbation"] = REPLICATE_PERTURBATION
-                params["seed"] = r + 1
-            rid = run_id(d)
-            if rid in seen:
-                a = seen[rid]
+            run = _make_run(study, vi, over, r, path)
+            if run.run_id in seen:
+                a = seen[run.run_id]
                 raise StudyError(
                     f"{path}: duplicate runs: run {a.variant + 1} and run {vi + 1} resolve to the "
-                    f"same scenario ({', '.join(f'{k} = {x}' for k, x in params.items()) or 'base'})"
+                    f"same scenario ({', '.join(f'{k} = {x}' for k, x in run.params.items()) or 'base'})"
                 )
-            run = Run(run_id=rid, index=len(study.runs), variant=vi, replicate=r, params=params, scenario=d)
-            seen[rid] = run
+            seen[run.run_id] = run
             study.runs.append(run)
+    if study.search is not None:
+        from .. import quantities as Q
+        from .search import check_quantity
+        wheels, features = Q.shape_of(r.scenario for r in study.runs)
+        check_quantity(str(path), study.search, Q.summary_columns(wheels, features=features))
     return study
+
+
+def _make_run(study, vi, over, r, path):
+    """Run ``r`` (replicate) of the grid point ``vi`` with the overrides ``over``."""
+    try:
+        sc = study.base_scenario.with_overrides({**over, "name": study.name})
+    except ScenarioError as e:
+        desc_v = ", ".join(f"{k} = {_param_value(x)}" for k, x in over.items()) or "the base scenario"
+        raise StudyError(f"{path}: run {vi + 1} ({desc_v}): {e}") from None
+    d = sc.to_dict()
+    params = {k: _param_value(x) for k, x in over.items()}
+    if study.replicates > 1:
+        d["seed"] = r + 1
+        if d["perturbation"] == 0.0:
+            d["perturbation"] = REPLICATE_PERTURBATION
+        params["seed"] = r + 1
+    return Run(run_id=run_id(d), index=len(study.runs), variant=vi, replicate=r, params=params, scenario=d)
+
+
+def _search_pairs(study, table, variants, path):
+    """With [search]: the grid points (study.points) and the scan's (point, overrides) pairs."""
+    from .search import parse_search
+    varied = {n for v in variants for n in v}
+    study.search = parse_search(str(path), table, varied)
+    if study.replicates > 1:
+        raise StudyError(f"{path}: [search] takes one run per value: [study] replicates = "
+                         f"{study.replicates} is not allowed with it (use 1)")
+    study.points = variants
+    xs = study.search.scan_values()
+    return [(vi, {**v, study.search.parameter: x}) for vi, v in enumerate(variants) for x in xs]
+
+
+def search_run(study, variant, value):
+    """The run of grid point ``variant`` at ``value`` of the searched parameter: the study's run
+    when it has it, else a new one (the run id a grid with that value gives) added to
+    study.runs; None when the study cannot make runs (read from its results folder)."""
+    name = study.search.parameter
+    for run in study.runs:
+        if run.variant == variant and run.params.get(name) == value:
+            return run
+    if study.base_scenario is None:
+        return None
+    run = _make_run(study, variant, {**study.points[variant], name: value}, 0, study.source)
+    study.runs.append(run)
+    return run
 
 
 def _storage(path, meta):
@@ -382,5 +427,7 @@ def resolved_toml(study):
         lines += ["", "[[zip]]"] + [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in g.items()]
     for r in study.explicit:
         lines += ["", "[[runs]]"] + [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in r.items()]
+    if study.search is not None:
+        lines += ["", "[search]"] + [f"{k} = {_toml_value(v)}" for k, v in study.search.as_dict().items()]
     return "\n".join(lines) + "\n"
 

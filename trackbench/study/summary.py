@@ -9,6 +9,7 @@ import pandas as pd
 
 from .. import quantities as Q
 from . import store
+from .search import SearchSpec
 from .spec import Run, Study, StudyError, load_study
 
 SPREAD_LIMIT = 0.05  # replicates: flag a quantity whose (max - min) / |median| exceeds this
@@ -29,30 +30,15 @@ SCREEN = (
 )
 
 
-def _wheels(study):
-    n = {int(r.scenario["vehicle"]["n_wheels"]) for r in study.runs}
-    return max(n)
-
-
-def _features(study):
-    """The models some run of the study has: "closed" (track), "soil" (soft soil)."""
-    out = set()
-    for r in study.runs:
-        if r.scenario["track"].get("layout") == "closed":
-            out.add("closed")
-        if r.scenario["terrain"].get("soil", "rigid") != "rigid":
-            out.add("soil")
-    return out
-
-
 def peak_columns(study):
     """The summary's peak and mean columns, in summary order (replicate statistics cover these)."""
-    return Q.peak_columns(_wheels(study), _features(study))
+    return Q.peak_columns(*Q.shape_of(r.scenario for r in study.runs))
 
 
 def summary_frame(study):
     """One row per run of the study (pending when it has not run), from the runs' run.json."""
-    results = Q.summary_columns(_wheels(study), features=_features(study))
+    wheels, features = Q.shape_of(r.scenario for r in study.runs)
+    results = Q.summary_columns(wheels, features=features)
     rows = []
     for run in study.runs:
         rec = store.read_run(study.output, run.run_id) or {"status": "pending", "status_message": ""}
@@ -135,16 +121,27 @@ def format_table(df, rep=None, params=()):
 
 
 def _study_of(path):
-    """A study file, or a results folder (its runs.json, written by `study run`)."""
+    """A study file, or a results folder (its runs.json, written by `study run`). A study file
+    with [search] gets the runs its search has asked for so far (limits.replay)."""
     path = Path(path)
     if not path.is_dir():
-        return load_study(path)
+        return _searched(load_study(path))
     m = store.read_json(path / "runs.json")
     if m is None:
         return load_study(path / "study.toml", output=path)
+    search = SearchSpec(**m["search"]) if m.get("search") else None
     study = Study(name=m["name"], description=m["description"], source=path / "study.toml", output=path,
-                  replicates=m["replicates"], base={}, param_names=m["param_names"])
+                  replicates=m["replicates"], base={}, param_names=m["param_names"], search=search,
+                  points=m.get("points", []))
     study.runs = [Run(**r) for r in m["runs"]]
+    return study
+
+
+def _searched(study):
+    """A study file's study, with [search] the runs its search has asked for so far added."""
+    if study.search is not None and Path(study.output).is_dir():
+        from .limits import replay
+        replay(study)
     return study
 
 
@@ -170,7 +167,7 @@ def study_folder(path):
     study = load_study(path)
     if not Path(study.output).is_dir():
         raise StudyError(f"no results of study {study.name}: {missing_folder(study)}")
-    return study, Path(study.output)
+    return _searched(study), Path(study.output)
 
 
 def open_run(path, run):
