@@ -1,5 +1,6 @@
 """The ground's memories, moved only after an accepted step: the soil's deepest sinkage and
-touchdown points (soil_jit.remember_sinkage) and the bristles' anchors
+touchdown points (soil_jit.remember_sinkage; along the step's interpolant before it:
+solvers/common/sinkage.py) and the bristles' anchors
 (grip.remember_grip). A rejected step leaves no trace in either."""
 
 from numba import njit

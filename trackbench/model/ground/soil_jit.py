@@ -8,13 +8,16 @@ z_m is the soil's memory along x: one node per cell centre (ModelArrays.rut), sm
 interpolated between the two nodes around x (rut_nodes), so that a pin sliding along the
 ground meets a memory with no jumps and no kinks (a jump in z_m is a jump in the elastic
 branch's pressure, which every step across a cell boundary met and was rejected at). It is
-raised only after an accepted step (remember_sinkage), so a rejected step leaves no trace,
-and the pressure is continuous where it is raised (at z = z_m both branches agree).
+raised only after an accepted step (remember_sinkage from the step's end state, and before it
+solvers/common/sinkage.py from the step's interpolant: the deepest sinkage of a pin that turned
+inside the step), so a rejected step leaves no trace, and the pressure is continuous where it is
+raised at the step's end (at z = z_m both branches agree).
 
 Shear by Janosi-Hanamoto, tau = (c + p tan phi)(1 - exp(-j / K)), on the pin's area A: the
 shear displacement j is the pin's displacement along the surface since it touched the soil
-(ModelArrays.touchdown, set after the accepted step in which it touched down, cleared when it
-leaves), so a pin that slips by j shears the soil by j; it replaces Coulomb friction on soil."""
+(ModelArrays.touchdown, set after the accepted step in which it touched down, where its sinkage
+crossed zero along the step's interpolant (solvers/common/sinkage.py), cleared when it leaves),
+so a pin that slips by j shears the soil by j; it replaces Coulomb friction on soil."""
 
 import math
 
@@ -172,9 +175,10 @@ def soil_shear(x, y, x0, y0, t, normal, par):
 
 @njit(**BORROW)
 def remember_sinkage(m, w):
-    """After an accepted step (the last evaluation was at its end): the memory keeps the
-    deepest sinkage a pin reached (raise_memory); a pin that touched the soil in the step
-    keeps where, one that left it forgets."""
+    """After an accepted step (the last evaluation was at its end), after the memory has been
+    raised along the step (solvers/common/sinkage.py): the memory keeps the sinkage a pin has
+    at the step's end (raise_memory); a pin that touched the soil in the step keeps where (its
+    end position where the interpolant did not locate it), one that left it forgets."""
     if m.par[P_SOIL] == 0.0:
         return
     for b in range(w.sink.shape[0]):

@@ -38,6 +38,7 @@ from ..common.control import (
 from ..common.events import first_contact_switch
 from ..common.monitor import update_peaks
 from ..common.pin_jacobian import factor, pin_jacobian, solve, times_j
+from ..common.sinkage import remember_inside_step
 from ..common.stepping import accepted_status, end_of_step, error_norm, keep_end, loop_first, samples
 
 ArkWork = namedtuple("ArkWork", [
@@ -164,6 +165,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
             keep_end(w, lw.end)
         n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
         if memory:
+            remember_inside_step(y, K[0], y_new, K[s], h, m, ev, lw.end)   # the soil's, along the step
             remember_ground(m, lw.end)
         n_rhs += n_new - n_out
         n_out = n_new
