@@ -5,17 +5,32 @@ end state alone, which makes it depend on where the steps happened to end: a pin
 deeper inside a step and rose again before its end left a shallower rut, and a pin that
 touched down inside a step had its shear counted from where it was at the step's end."""
 
+import numpy as np
 from numba import njit
 
-from ...model.core.indices import K_PIN_GROUND, NB_COUNT, P_LINK_LENGTH, P_RUT_DX, P_RUT_X0, P_SOIL, PN_LAST
+from ...model.contact.gaps import ground_distance, pin_ground_selection, pin_segment_valid, segment_coords
+from ...model.contact.laws import GEOMETRY_CONTINUOUS
+from ...model.core.indices import (
+    K_PIN_GROUND,
+    NB_COUNT,
+    P_CONTACT_GEOMETRY,
+    P_LINK_LENGTH,
+    P_PAD_GROUND,
+    P_RUT_DX,
+    P_RUT_X0,
+    P_SOIL,
+    PN_LAST,
+    SEG_LENGTH,
+)
 from ...model.core.indices_jit import nq_of
 from ...model.core.jit import BORROW
 from ...model.ground.soil_jit import raise_memory
-from .events import BISECTIONS, _gap_at, _pin_at
+from .events import BISECTIONS, _pin_at
 from .hermite import quintic_basis
 
-TURN_PROBE = 1e-3  # fraction of the step: a pin whose sinkage falls over this last bit of a step
-# and rose over its first bit (or since it touched down) turned inside it
+# fraction of the step: a pin whose sinkage falls over this last bit of a step and rose over its
+# first bit (or since it touched down) turned inside it
+TURN_PROBE = 1e-3
 GOLDEN_STEPS = 40  # golden-section steps for the turning point (the bracket shrinks to 4e-9)
 GOLDEN = 0.6180339887498949
 
@@ -23,13 +38,24 @@ GOLDEN = 0.6180339887498949
 @njit(**BORROW)
 def _sinkage_at(i, t, step, nq, m, n_links, ev):
     """Pin i's sinkage at fraction t of the step: the deepest of its valid ground contacts, as
-    the force kernel's (ground_contact._pins_on_ground); -1 m where it has none."""
+    the force kernel's (ground_contact._pins_on_ground, the same selection); -1 m where it has
+    none."""
     row = m.nbr_rows[K_PIN_GROUND] + i
+    if m.nbr[row, NB_COUNT] == 0:
+        return -1.0
+    px, py = _pin_at(i, quintic_basis(t), step, nq, m, n_links, ev)
+    hg = m.par[P_PAD_GROUND]
+    if m.par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS:
+        return hg - ground_distance(px, py, m.seg, m.nbr, row)[0]
+    inside, n_below, best = pin_ground_selection(px, py, m.seg, m.nbr, row, hg)
     z = -1.0
+    if best == -np.inf:
+        return z
     for j in range(m.nbr[row, NB_COUNT]):
-        valid, g = _gap_at(K_PIN_GROUND, i, m.nbr[row, 1 + j], t, step, nq, m, n_links, ev)
-        if valid and g > z:
-            z = g
+        sj = m.nbr[row, 1 + j]
+        lam, s, _ = segment_coords(px, py, m.seg, sj)
+        if hg - s > z and pin_segment_valid(lam, s, m.seg[sj, SEG_LENGTH], inside, n_below, best):
+            z = hg - s
     return z
 
 
@@ -52,9 +78,10 @@ def _touchdown(i, step, nq, m, n_links, ev):
 def _deepest(i, lo, z_end, step, nq, m, n_links, ev):
     """(t, z): pin i's deepest sinkage in [lo, 1] of the step where it turned inside it (its
     sinkage rose after lo and falls before the end; golden-section search), else (1, z_end)."""
-    z_lo = _sinkage_at(i, lo, step, nq, m, n_links, ev)
-    rising = _sinkage_at(i, lo + TURN_PROBE * (1.0 - lo), step, nq, m, n_links, ev) > z_lo
-    if not rising or _sinkage_at(i, 1.0 - TURN_PROBE * (1.0 - lo), step, nq, m, n_links, ev) <= z_end:
+    probe = TURN_PROBE * (1.0 - lo)
+    if _sinkage_at(i, 1.0 - probe, step, nq, m, n_links, ev) <= z_end:
+        return 1.0, z_end
+    if _sinkage_at(i, lo + probe, step, nq, m, n_links, ev) <= _sinkage_at(i, lo, step, nq, m, n_links, ev):
         return 1.0, z_end
     a, b = lo, 1.0
     c = b - GOLDEN * (b - a)
