@@ -48,7 +48,7 @@ def rhs_microseconds(ds, sc):
     m = Model(sc, eq, ground)
     nq = L.n_coordinates(m.nw, m.n_links)
     i = int(np.searchsorted(ds.time.values, 0.3))
-    y = np.zeros(2 * nq + 1)
+    y = np.zeros(m.ny)
     y[[L.Q_X, L.Q_Y, L.Q_PITCH]] = [float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")]
     y[L.Q_ARM : L.Q_ARM + m.nw] = ds.arm_angle.values[i]
     off = L.pin_offset(m.nw)

@@ -45,7 +45,7 @@ class Window:
         self.model = S.Model(sc, eq, self.ground)
         self.y0 = run_function("reduced", "dopri5")(sc, self.model, S.initial_state(sc, eq)).y[-1].copy()
         self.ny = self.y0.size
-        self.nq = L.nq_of(self.ny)
+        self.nq = self.model.nq
         self.diag = np.empty(L.n_diag(self.model.nw, self.model.n_links))
         self.jw = PJ.jacobian_work(self.model, self.ny)
         self.pin_of = {}

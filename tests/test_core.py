@@ -130,7 +130,7 @@ def test_neighbour_lists_equal_full_search(paper_run):
         res = []
         off = L.pin_offset(5)
         for i in range(0, ds.sizes["time"], 97):
-            y = np.zeros(2 * nq + 1)
+            y = np.zeros(m.ny)
             y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (
                 float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")
             )

@@ -71,7 +71,7 @@ def test_event_contact_decision_equals_the_kernels(geometry, request):
     checked = {"wheel": 0, "ground": 0}
     for i in rng.choice(ds.sizes["time"], 60, replace=False):
         for _ in range(5):
-            y = np.zeros(2 * nq + 1)
+            y = np.zeros(model.ny)
             y[L.Q_X], y[L.Q_Y], y[L.Q_PITCH] = (
                 float(ds[v][i]) for v in ("chassis_x", "chassis_y", "chassis_pitch")
             )

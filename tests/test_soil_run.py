@@ -170,7 +170,7 @@ def test_soil_on_any_terrain_shape():
 
 def test_bristle_friction_leaves_the_soil_shear_alone():
     """On soft soil Janosi-Hanamoto's shear replaces friction: the bristle law changes
-    nothing there (its anchors would be the soil's touchdown points)."""
+    nothing there (the state holds no bristle deflections)."""
     base = {
         "terrain": {"kind": "flat", "soil": "lete_sand"},
         "contact.friction": 0.6,

@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 
+from .model.contact.laws import bristle_active
 from .model.core import indices as L
 from .model.core.bundles import arm_table, model_arrays, work_arrays
 from .model.vehicle.parameters import arm_damping, pack, total_mass
@@ -85,10 +86,23 @@ def _closed_velocities(scenario, eq, y0):
         y0[2 * nq + L.Y_DRIVE_INTEGRAL] = eq.info["holding_torque"] / scenario["drive.gain_i"]
 
 
+def bristle_states(scenario: Scenario):
+    """How many bristle deflections the run's state holds after its extras: one per free pin
+    where the bristle law acts (contact/laws.bristle_active; Model.n_bristles), else none."""
+    par = pack(scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"])[0]
+    for k, v in soil_par(scenario).items():
+        par[k] = v
+    if not bristle_active(par):
+        return 0
+    n = scenario["track.n_links"]
+    return n if _closed(scenario) else n - 1
+
+
 def initial_state(scenario: Scenario, eq):
-    """y0 = (q, qd, W, ...): the equilibrium moving at `speed`, pins nudged if asked."""
+    """y0 = (q, qd, W, ..., bristles): the equilibrium moving at `speed`, pins nudged if
+    asked; every bristle at rest (z = 0: the equilibrium holds the pins without friction)."""
     nq = eq.q.size
-    y0 = np.zeros(L.n_state(nq))
+    y0 = np.zeros(L.n_state(nq, bristle_states(scenario)))
     y0[:nq] = eq.q
     nw = scenario["vehicle.n_wheels"]
     off = L.pin_offset(nw)
@@ -166,7 +180,15 @@ class Model:
         )
         self.work = work_arrays(self.arrays, self.nw, self.n_links)
         self.weight = eq.weight if self.closed else total_mass(v, tr) * scenario["gravity"]
-        self.nq = L.n_coordinates(self.nw, self.n_links, self.closed)
+        self.nq = int(self.arrays.pins[L.PN_NQ])
+        self.ny = int(self.arrays.pins[L.PN_NY])   # the state's length
+        # bristle deflections after the extras of y (indices.bristle_state), 0 unless the bristle law acts
+        self.n_bristles = self.ny - L.n_state(self.nq)
+
+    @property
+    def has_bristles(self):
+        """The state holds a bristle deflection per free pin (contact.friction_law = "bristle")."""
+        return self.n_bristles > 0
 
     @property
     def par(self):

@@ -90,7 +90,7 @@ def _energies(result, nq):
             T,
             tors + tens + d[:, L.D_E_PAD_WHEEL] + d[:, L.D_E_PAD_GROUND],
             "J",
-            "elastic energy: torsion bars, links, wheel and ground pads",
+            "elastic energy: torsion bars, links, wheel and ground pads (and bristles)",
         ),
         "energy_gravity": _var(T, grav, "J", "gravity potential relative to t = 0"),
         "energy_balance": _var(
@@ -120,6 +120,17 @@ def _energies(result, nq):
             "energy",
         ),
     }
+
+
+def _bristles(model, result):
+    """The bristle law's deflections (states after y's extras), per pin; NaN for the paper
+    layout's track ends, which hold none."""
+    first = L.bristle_state(model.nq, 1)
+    z = result.y[:, first:first + model.n_bristles]
+    if not model.closed:
+        z = np.pad(z, ((0, 0), (1, 1)), constant_values=np.nan)
+    text = "deflection of the pin's bristle along the ground's tangent (bristle friction law)"
+    return {"bristle_deflection": _var(P, z, "m", text)}
 
 
 _SCALAR_PEAKS = [  # name, peaks row, units, text, divided by E0
@@ -216,6 +227,8 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
         v.update(closed_layout_vars(model, result, scenario, placed))
+    if model.has_bristles:
+        v.update(_bristles(model, result))
     rut_x = None
     if model.par[L.P_SOIL] != 0.0:
         sv, rut_x = soil_vars(model, result, ground, placed)

@@ -4,9 +4,10 @@ scipy's OdeSolver documents its own). solvers/registry.py names the integrators.
 A solver is a module with ``run(scenario, model, y0) -> RunResult`` that:
 
 1. integrates the model (assembly.Model: the compiled arrays of one run) from the reduced
-   state y0 = (q, qd, W) at t = 0 to ``scenario["duration"]``, with its settings from the
-   validated scenario only (``control(scenario)``: tolerance, output interval, step limits;
-   ``method``); it validates nothing itself;
+   state y0 = (q, qd, extras, bristle deflections: model/core/indices.py) at t = 0 to
+   ``scenario["duration"]``, with its settings from the validated scenario only
+   (``control(scenario)``: tolerance, output interval, step limits; ``method``); it
+   validates nothing itself;
 2. may integrate in coordinates of its own, but takes and returns the reduced layout
    (model/core/indices.py): every output means the same whichever solver made it;
 3. controls its step by an error estimate and never steps over a contact switch: an onset
@@ -16,8 +17,9 @@ A solver is a module with ``run(scenario, model, y0) -> RunResult`` that:
    dense output between accepted steps, the peaks over every accepted step
    (solvers/common/monitor.py update_peaks, so no impulse between samples is missed), the
    statistics (indices.S_*: steps, rejected steps, right-hand sides, status, t_final);
-5. moves the ground's memories (soil sinkage, bristle anchors, approach speeds) only after
-   an accepted step, never inside one (a rejected step leaves no trace);
+5. moves the ground's memories (soil sinkage, approach speeds) only after an accepted step,
+   never inside one (a rejected step leaves no trace); the bristle law's deflections are
+   states (in the error test and the dense output), not memories;
 6. stops at the first failure with a status code (status.Result: NaN, step-size underflow,
    a wheel through the track, max steps), keeping the samples up to there; compiled code
    never raises;
@@ -42,7 +44,7 @@ Control = namedtuple("Control", ["t_end", "dt_out", "rtol", "atol", "h0", "h_max
 
 # Filled by the compiled loops: samples on the output grid, peaks over every accepted step.
 Outputs = namedtuple("Outputs", [
-    "y",         # (n_out, 2 nq + 1) reduced state (q, qd, W) at the output times
+    "y",         # (n_out, ny) reduced state (q, qd, extras, bristles) at the output times
     "diag",      # (n_out, n_diag) forces and energies at the output times
     "peaks",     # (n_peaks, 6) value, time, then the last two samples (f, t)
     "stats",     # (N_STATS,) indices.S_*
@@ -52,7 +54,7 @@ Outputs = namedtuple("Outputs", [
 @dataclass
 class RunResult:
     time: np.ndarray          # (n_out,) output times
-    y: np.ndarray             # (n_out, 2 nq + 1) reduced state (q, qd, W) at the output times
+    y: np.ndarray             # (n_out, ny) reduced state (q, qd, extras, bristles) at the output times
     diag: np.ndarray          # (n_out, n_diag) forces and energies at the output times
     peaks: np.ndarray         # (n_peaks, 6) value, time, then the last two samples (f, t)
     stats: np.ndarray         # indices.S_*

@@ -20,6 +20,8 @@ validation needs them without a compiler); the compiled law is laws_jit.py.
 
 import math
 
+from ..core.indices import P_FRICTION, P_FRICTION_LAW, P_SOIL
+
 # contact.law
 LAW_LINEAR = 0
 LAW_POWER = 1
@@ -41,9 +43,16 @@ GEOMETRIES = {"paper": GEOMETRY_PAPER, "continuous": GEOMETRY_CONTINUOUS}
 
 # Friction between the track's pins and rigid ground (docs/model.md, "Beyond the paper: ground friction")
 FRICTION_REGULARISED = 0  # -mu p v_t / sqrt(v_t^2 + v_eps^2): no memory, stiff in stick
-FRICTION_BRISTLE = 1      # a tangential spring to an anchor on the ground that slips at mu p
+FRICTION_BRISTLE = 1      # a tangential spring and dashpot whose deflection slips at mu p (a state)
 FRICTION_LAWS = {"regularised": FRICTION_REGULARISED, "bristle": FRICTION_BRISTLE}
 BRISTLE_DAMPING_RATIO = 1.0   # the bristle's dashpot: critical for one pin on its spring
+
+
+def bristle_active(par):
+    """The bristle law acts (and the state holds a bristle deflection per free pin): friction
+    on rigid ground with contact.friction_law = "bristle" (on soft soil the soil's shear
+    replaces friction). Compiled as model/ground/grip.uses_bristle."""
+    return par[P_FRICTION] > 0.0 and par[P_FRICTION_LAW] == FRICTION_BRISTLE and par[P_SOIL] == 0.0
 
 
 def restitution_factor(damping, e):

@@ -45,11 +45,19 @@ def normal_force(law, delta, delta_dot, v0):
 
 
 @njit(**SCALAR)
-def bristle(limit, k, c, d, v_t):
-    """Bristle friction of a contact whose bristle (a tangential spring k with a dashpot c
-    to an anchor on the ground) is stretched by d and slides at v_t: -k d - c v_t, never
-    beyond the Coulomb force mu p = k limit. In stick the pin rides on the spring, whose
-    frequency an explicit step resolves, where the regularised law's slope mu p / v_eps
-    is a stiff damper; the anchor slips (model/ground/grip.py) where the spring exceeds mu p."""
-    f_max = k * limit
-    return min(max(-k * d - c * v_t, -f_max), f_max)
+def bristle(f_max, k, c, z, v_t):
+    """(friction force, dz/dt) of a bristle, a tangential spring k with a dashpot c, deflected
+    by z on a contact pressed with mu p = f_max whose pin slides at v_t. Sticking, the pin
+    rides on spring and dashpot: -k z - c v_t, and z follows the pin (dz/dt = v_t). Beyond
+    mu p either way the bristle slips: the force is mu p, and z moves so that spring and
+    dashpot carry just that, -k z - c dz/dt = -+mu p. Both are one Lipschitz-continuous
+    function of (z, v_t, f_max); off the ground (f_max = 0) the spring relaxes through its
+    dashpot, dz/dt = -k z / c. The stiffest rate is k / c (sliding) or the stick frequency
+    sqrt(k / m_pin), both below the pads' own, where the regularised law's slope mu p / v_eps
+    is a stiff damper."""
+    f = -k * z - c * v_t
+    if f > f_max:
+        return f_max, -(k * z + f_max) / c
+    if f < -f_max:
+        return -f_max, -(k * z - f_max) / c
+    return f, v_t

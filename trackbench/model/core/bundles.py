@@ -7,6 +7,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..contact.laws import bristle_active
 from . import indices as L
 
 # Fixed for a run, except the candidate lists (nbr, ref), which the contact search
@@ -23,14 +24,13 @@ ModelArrays = namedtuple("ModelArrays", [
     "counters",   # int (N_COUNTERS,) C_*
     "v0",         # (rows, width - 1) approach speed of each pair at its onset, nbr's row layout
                   # and the partner (link, pin or segment) as column; 0 = not in contact
-    "pins",       # int (N_PN,) which pin rows are free, PN_*
+    "pins",       # int (N_PN,) which pin rows are free and the state's layout (nq, len(y)), PN_*
     "loop",       # (N_LOOP,) sprocket, tensioner and drive of the closed layout, LP_*; empty for the paper's
     "guides",     # (n_guides, N_G_COLS) idler (row 0) and support rollers, G_*; no rows for the paper's
     "rut",        # (n_cells,) the soil's memory: deepest sinkage reached in each cell along x (m);
                   # empty on rigid ground (P_RUT_X0, P_RUT_DX place the cells)
     "touchdown",  # (n_pins, 2) soft soil: where each pin touched the soil, for its shear displacement;
-                  # bristle friction: where its bristle is anchored on the ground; NaN: off the
-                  # ground or touched down in the last step
+                  # NaN: off the soil or touched down in the last step
 ])
 
 # Scratch of one evaluation of the track forces: pin and wheel-centre kinematics in,
@@ -48,9 +48,8 @@ Work = namedtuple("Work", [
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
     "sink",       # (n_pins,) each pin's sinkage into soft soil at the last evaluation (m; 0 off it)
-    "grip",       # (n_pins, N_GRIP) bristle friction at the last evaluation (indices.G_*): the slip
-                  # limit mu p / k_t (m), the ground's unit tangent, the force, the pin's speed
-                  # along the tangent; NaN off the ground
+    "grip",       # (n_pins, N_GRIP) bristle friction at the last evaluation (indices.G_*): each free
+                  # pin's deflection (from y), force, speed along the ground and dz/dt
 ])
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
@@ -79,6 +78,8 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None,
     pins = np.zeros(L.N_PN, dtype=np.int64)
     pins[L.PN_LAST] = n_links if closed else n_links - 1
     pins[L.PN_CLOSED] = int(closed)
+    pins[L.PN_NQ] = L.n_coordinates(n_wheels, n_links, closed)
+    pins[L.PN_NY] = L.n_state(pins[L.PN_NQ], pins[L.PN_LAST] if bristle_active(par) else 0)
     return ModelArrays(np.ascontiguousarray(par, dtype=float), np.ascontiguousarray(arms, dtype=float),
                        np.ascontiguousarray(ends, dtype=float), np.ascontiguousarray(seg, dtype=float),
                        np.ascontiguousarray(corners, dtype=float).reshape(-1, 2), nbr,
@@ -98,7 +99,7 @@ def work_arrays(m, n_wheels, n_links):
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
             np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
             np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins),
-            np.full((n_pins, L.N_GRIP), np.nan))
+            np.zeros((n_pins, L.N_GRIP)))
     if not closed:
         return Work(*base)
     ng = m.guides.shape[0]

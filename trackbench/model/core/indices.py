@@ -1,12 +1,16 @@
 """Index tables: the one place that says where each quantity lives in the arrays
 the compiled kernels share.
 
-Reduced-coordinate state ``y`` (length ``2 * nq + 2``)::
+Reduced-coordinate state ``y`` (length ``n_state(nq, n_bristles)``)::
 
     q   = y[0:nq]          generalised coordinates
     qd  = y[nq:2*nq]       their rates
     W   = y[2*nq]          work done by all contact forces and dampers since t = 0 (J)
     D   = y[2*nq + 1]      energy dissipated by all dampers (contact damping included) (J)
+    ...                    the drive's work and its controller's integral (Y_*)
+    z_b = y[bristle_state(nq, b)]   the bristle law only (contact/laws.bristle_active): the
+                           deflection of free pin b's bristle along the ground (m), b = 1..last
+                           free pin; every other model's y ends with the extras
 
     q[Q_X], q[Q_Y]         chassis mass-centre position (m)
     q[Q_PITCH]             chassis pitch, counter-clockwise (rad)
@@ -58,13 +62,21 @@ Y_DRIVE_INTEGRAL = 3     # integral of the speed error of the speed drive's PI c
 N_Y_EXTRA = 4            # first-order components after (q, qd); the error test leaves them out
 
 
-def n_state(nq):
-    return 2 * nq + N_Y_EXTRA
+def n_state(nq, n_bristles=0):
+    """Length of y: (q, qd), the extras, one bristle deflection per free pin with the bristle law."""
+    return 2 * nq + N_Y_EXTRA + n_bristles
 
 
 def nq_of(ny):
-    """Number of generalised coordinates of a state of length ny."""
+    """Number of generalised coordinates of a state of length ny without bristle states (the
+    lee solver's; the reduced solver's kernels read nq from the model: pins[PN_NQ])."""
     return (ny - N_Y_EXTRA) // 2
+
+
+def bristle_state(nq, b):
+    """Index in y of the bristle deflection of free pin b (rows 1..pins[PN_LAST]); the bristle
+    law only (its y is longer, pins[PN_NY])."""
+    return 2 * nq + N_Y_EXTRA + b - 1
 
 
 def n_coordinates(n_wheels, n_links, closed=False):
@@ -167,10 +179,12 @@ def neighbour_width(n_links, n_segments):
 
 NB_COUNT = 0             # column of the candidate count; entries follow in 1..count
 
-# --- which pin rows are free, ``pins`` (int) -------------------------------------------
+# --- which pin rows are free, and the state's layout, ``pins`` (int) ---------------------
 PN_LAST = 0  # last free pin row: n_links - 1 (paper: pin n_links rides on the chassis), n_links (closed)
 PN_CLOSED = 1            # 1: closed loop (row 0 copies row n_links), 0: the paper's ends on the chassis
-N_PN = 2
+PN_NQ = 2                # the state's layout: nq, the number of generalised coordinates
+PN_NY = 3                # the length of y, n_state(nq, bristle states)
+N_PN = 4
 
 # --- sprocket, idler, tensioner and drive of the closed layout, ``loop`` (empty: paper) --
 LP_SPROCKET_X = 0        # body point of the sprocket axis (m)
@@ -281,13 +295,12 @@ P_BRISTLE_K = 39         # tangential stiffness k_t (N/m)
 P_BRISTLE_C = 40         # its dashpot, 2 zeta sqrt(k_t m_pin) (N s/m)
 N_PAR = 41
 
-# --- columns of Work.grip: the bristle friction at the last evaluation (model/ground/grip.py) ---------
-G_LIMIT = 0              # slip limit mu p / k_t (m)
-G_TX = 1                 # the ground's unit tangent
-G_TY = 2
-G_FORCE = 3              # the friction force along it (N)
-G_SPEED = 4              # the pin's speed along it (m/s)
-N_GRIP = 5
+# --- columns of Work.grip: each free pin's bristle at the last evaluation (model/ground/grip.py) -------
+G_DEFLECTION = 0         # in: its deflection z along the ground's tangent, from y (m)
+G_FORCE = 1              # out: the friction force along the tangent (N; 0 off the ground)
+G_SPEED = 2              # out: the pin's speed along it (m/s; 0 off the ground)
+G_RATE = 3               # out: dz/dt (m/s)
+N_GRIP = 4
 
 # --- columns of the arm table, ``arms`` ----------------------------------------------
 ARMS_PX = 0              # pivot body point

@@ -66,6 +66,8 @@ from ..core.indices import (
     P_GRAVITY,
     P_MIN_APPROACH,
     P_PIN_MASS,
+    PN_LAST,
+    PN_NQ,
     Q_ARM,
     Q_PITCH,
     Q_X,
@@ -84,8 +86,9 @@ from ..core.indices import (
     Y_DRIVE_WORK,
     Y_WORK,
 )
-from ..core.indices_jit import diag_tension, nq_of, q_idler, q_pin, q_sprocket
+from ..core.indices_jit import diag_tension, q_idler, q_pin, q_sprocket
 from ..core.jit import BORROW, INLINE, KERNEL
+from ..ground.grip import bristle_rates, start_bristles, uses_bristle
 from ..ground.ground_contact import ground_contacts
 from ..vehicle.drive import drawbar_on_chassis, drive_torque, has_drawbar, held_speed
 from ..vehicle.kinematics import body_offset, place_wheels, wheel_velocities
@@ -325,7 +328,7 @@ def closed_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for the closed layout (reduced.reduced_rhs for the paper's); fills diag
     and w.genf."""
     par, arms, lp = m.par, m.arms, m.loop
-    nq = nq_of(y.shape[0])
+    nq = m.pins[PN_NQ]
     q = y[:nq]
     qd = y[nq:2 * nq]
     nw = arms.shape[0]
@@ -333,7 +336,12 @@ def closed_rhs(y, m, w, ydot, diag):
     i_spr = q_sprocket(nw, n)
     i_idl = q_idler(nw, n)
     c, s = _closed_positions(q, qd, m, w)
+    bristles = uses_bristle(par)
+    if bristles:
+        start_bristles(y, nq, m.pins[PN_LAST], par, w.grip)
     closed_loads(w, m, diag)
+    if bristles:
+        bristle_rates(ydot, nq, m.pins[PN_LAST], par, w.grip, diag)
     # the drive (forward = clockwise, psi counter-clockwise) and the tensioner
     omega = -qd[i_spr]
     tau, d_integral = drive_torque(lp, held_speed(lp, qd[Q_X], omega), omega, y[2 * nq + Y_DRIVE_INTEGRAL])

@@ -15,7 +15,7 @@ from numba import njit
 from ..core import fixed_math as fm
 from ..core import indices as L
 from ..core.bundles import arm_table, model_arrays, work_arrays
-from ..core.indices_jit import n_coordinates, n_state, pin_offset, q_idler, q_sprocket
+from ..core.indices_jit import n_coordinates, pin_offset, q_idler, q_sprocket
 from ..core.jit import KERNEL
 from ..ground.terrain import flat_ground
 from ..vehicle.parameters import equilibrium_arm_angle, pack, total_mass
@@ -86,12 +86,13 @@ class StaticProblem:
 @njit(**KERNEL)
 def _loads_at_rest(q, m, w, diag):
     """Pin and wheel positions, track forces (work) and diag at configuration q, at rest.
-    The solver's own right-hand side computes them: one compiled copy of the contact code."""
+    The solver's own right-hand side computes them: one compiled copy of the contact code
+    (with the bristle law, every bristle at rest: z = 0)."""
     nq = q.shape[0]
-    y = np.zeros(n_state(nq))
+    y = np.zeros(m.pins[L.PN_NY])
     for k in range(nq):  # loops, not slice assignments: see solvers/common/arrays.py
         y[k] = q[k]
-    ydot = np.empty(n_state(nq))
+    ydot = np.empty(m.pins[L.PN_NY])
     rhs(y, m, w, ydot, diag)
 
 
@@ -225,8 +226,7 @@ def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
     about its pivot; returns the horizontal force."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
-    nq = w.genf.shape[0]
-    y = np.zeros(n_state(nq))
+    y = np.zeros(m.pins[L.PN_NY])   # at rest: every bristle's deflection 0
     y[L.Q_Y] = u[0]
     y[L.Q_PITCH] = u[1]
     for i in range(nw):

@@ -33,6 +33,8 @@ from ..core.indices import (
     P_GRAVITY,
     P_PIN_MASS,
     P_TORSION_STIFFNESS,
+    PN_LAST,
+    PN_NQ,
     Q_ARM,
     Q_PITCH,
     Q_X,
@@ -40,8 +42,9 @@ from ..core.indices import (
     Y_DISSIPATED,
     Y_WORK,
 )
-from ..core.indices_jit import nq_of, q_pin
+from ..core.indices_jit import q_pin
 from ..core.jit import BORROW, INLINE
+from ..ground.grip import bristle_rates, start_bristles, uses_bristle
 from ..vehicle.kinematics import body_offset, positions
 from .track_loads import track_loads
 
@@ -205,14 +208,19 @@ def store_state_energies(diag, energies, ax, ay):
 
 @njit(**BORROW)
 def reduced_rhs(y, m, w, ydot, diag):
-    """ydot = f(y) for y = (q, qd, W, D); fills diag (forces, energies, status)."""
+    """ydot = f(y) for y = (q, qd, W, D, ..., bristles); fills diag (forces, energies, status)."""
     par, arms = m.par, m.arms
     apos, avel, fpin, wc, wv, fwheel, arm = w.apos, w.avel, w.fpin, w.wc, w.wv, w.fwheel, w.arm
-    nq = nq_of(y.shape[0])
+    nq = m.pins[PN_NQ]
     q = y[:nq]
     qd = y[nq:2 * nq]
     c, s = positions(q, qd, par, arms, m.ends, apos, avel, wc, wv, arm)
+    bristles = uses_bristle(par)
+    if bristles:
+        start_bristles(y, nq, m.pins[PN_LAST], par, w.grip)
     track_loads(w, m, diag)
+    if bristles:
+        bristle_rates(ydot, nq, m.pins[PN_LAST], par, w.grip, diag)
     a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s,
                                                 _track_ends(q, par, apos, fpin))
     d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal

@@ -1,87 +1,86 @@
-"""Bristle friction between the track's pins and rigid ground, compiled: each pin on the
-ground holds a bristle, a tangential spring with a dashpot to an anchor (ModelArrays.touchdown)
-that stays where the pin touched down while the bristle carries less than mu p, and is dragged
-along while the pin slides (the force then at mu p). The anchor moves only after an accepted
-step (remember_grip), so a rejected step leaves no trace, and it moves so that the force at the
-step's end stays what the step ended with (the next step starts from that derivative); within a
-step the force is the spring's and the dashpot's, capped at mu p (laws_jit.bristle), a
-continuous function of the state. A pin on two segments at once (the paper's geometry at a
-concave corner) holds its bristle on the first; the regularised law acts on the other."""
+"""Bristle friction between the track's pins and rigid ground, compiled: each free pin holds
+a bristle, a tangential spring k_t with a dashpot c, whose deflection z along the ground is a
+state of the ODE (indices.bristle_state: after the extras of y). The law (laws_jit.bristle):
+sticking, the force is -k_t z - c v_t and z follows the pin; beyond mu p the bristle slips,
+the force is mu p and z moves so that spring and dashpot carry it; off the ground it relaxes
+through its dashpot. Its rate depends on the pin's own position, velocity and z alone.
 
-import math
+The right-hand side copies z into Work.grip with every pin as if off the ground
+(start_bristles), the pins' ground kernel evaluates the law for each pin's first ground
+contact (pin_grip; at a concave corner the regularised law acts on the others), and
+bristle_rates writes dz/dt into ydot with the bristles' stored energy and dissipated power."""
 
 from numba import njit
 
-from ..contact.laws import FRICTION_BRISTLE
+from ..contact.laws import bristle_active
 from ..contact.laws_jit import bristle
 from ..core.indices import (
+    D_DISSIPATION,
+    D_E_PAD_GROUND,
+    G_DEFLECTION,
     G_FORCE,
-    G_LIMIT,
+    G_RATE,
     G_SPEED,
-    G_TX,
-    G_TY,
     P_BRISTLE_C,
     P_BRISTLE_K,
     P_FRICTION,
-    P_FRICTION_LAW,
-    P_SOIL,
 )
+from ..core.indices_jit import bristle_state
 from ..core.jit import BORROW, INLINE
 
+uses_bristle = njit(**INLINE)(bristle_active)
 
-@njit(**INLINE)
-def uses_bristle(par):
-    """On soft soil the soil's shear replaces friction and the anchors are the soil's."""
-    return par[P_FRICTION] > 0.0 and par[P_FRICTION_LAW] == FRICTION_BRISTLE and par[P_SOIL] == 0.0
-
-
-@njit(**INLINE)
-def bristle_stretch(b, apos, anchor, tx, ty):
-    """How far pin b is from its anchor along the ground's unit tangent (0: no anchor yet,
-    the pin touched down in this step)."""
-    if anchor[b, 0] != anchor[b, 0]:
-        return 0.0
-    return (apos[b, 0] - anchor[b, 0]) * tx + (apos[b, 1] - anchor[b, 1]) * ty
-
-
-@njit(**INLINE)
-def pin_grip(b, apos, avel, t, p, par, anchor, grip):
-    """(friction force along the unit tangent t, its dissipated power) of pin b pressed on
-    the ground with normal force p; keeps the slip limit and t in grip for remember_grip."""
-    tx, ty = t
-    k = par[P_BRISTLE_K]
-    limit = par[P_FRICTION] * p / k
-    v_t = avel[b, 0] * tx + avel[b, 1] * ty
-    f = bristle(limit, k, par[P_BRISTLE_C], bristle_stretch(b, apos, anchor, tx, ty), v_t)
-    grip[b, G_LIMIT] = limit
-    grip[b, G_TX] = tx
-    grip[b, G_TY] = ty
-    grip[b, G_FORCE] = f
-    grip[b, G_SPEED] = v_t
-    return f, -f * v_t
+# m: a bristle off the ground relaxed below this stops relaxing. Its rate, k_t z / c < 1e-97
+# m/s, is far below any tolerance, and the stop keeps subnormal numbers (z^2 below 1e-308
+# after ~0.7 s in the air, z itself later), which some CPUs compute ~100x slower, out of
+# every evaluation.
+Z_RELAXED = 1e-100
 
 
 @njit(**BORROW)
-def remember_grip(m, w):
-    """After an accepted step (w: the evaluation at its end): a pin that touched down anchors
-    its bristle where it is; one whose force is at mu p (sliding) drags its anchor to where
-    spring and dashpot give that force, -k_t d - c v_t = f, so the force stays f; one that
-    left the ground forgets its anchor."""
-    if not uses_bristle(m.par):
-        return
-    anchor, grip = m.touchdown, w.grip
-    for b in range(grip.shape[0]):
-        limit = grip[b, G_LIMIT]
-        if limit != limit:
-            anchor[b, 0] = math.nan
-            anchor[b, 1] = math.nan
-        elif anchor[b, 0] != anchor[b, 0]:
-            anchor[b, 0] = w.apos[b, 0]
-            anchor[b, 1] = w.apos[b, 1]
-        else:
-            k, f = m.par[P_BRISTLE_K], grip[b, G_FORCE]
-            if abs(f) >= k * limit:      # capped (laws_jit.bristle returns k limit exactly)
-                d = bristle_stretch(b, w.apos, anchor, grip[b, G_TX], grip[b, G_TY])
-                slide = d - (-f - m.par[P_BRISTLE_C] * grip[b, G_SPEED]) / k
-                anchor[b, 0] += slide * grip[b, G_TX]
-                anchor[b, 1] += slide * grip[b, G_TY]
+def start_bristles(y, nq, last, par, grip):
+    """Before the loads: each free pin's deflection from y, and the pin as if off the ground
+    (no force; its bristle relaxes through its dashpot, laws_jit.bristle with mu p = 0, down to
+    Z_RELAXED) until pin_grip finds its ground contact."""
+    k, c = par[P_BRISTLE_K], par[P_BRISTLE_C]
+    for b in range(1, last + 1):
+        z = y[bristle_state(nq, b)]
+        rate = 0.0
+        if abs(z) > Z_RELAXED:
+            _, rate = bristle(0.0, k, c, z, 0.0)
+        grip[b, G_DEFLECTION] = z
+        grip[b, G_FORCE] = 0.0
+        grip[b, G_SPEED] = 0.0
+        grip[b, G_RATE] = rate
+
+
+@njit(**INLINE)
+def pin_grip(b, avel, t, p, par, grip):
+    """The friction force along the unit tangent t on pin b pressed on the ground with normal
+    force p; the force, the pin's speed along t and dz/dt into grip."""
+    tx, ty = t
+    v_t = avel[b, 0] * tx + avel[b, 1] * ty
+    f, rate = bristle(par[P_FRICTION] * p, par[P_BRISTLE_K], par[P_BRISTLE_C], grip[b, G_DEFLECTION], v_t)
+    grip[b, G_FORCE] = f
+    grip[b, G_SPEED] = v_t
+    grip[b, G_RATE] = rate
+    return f
+
+
+@njit(**BORROW)
+def bristle_rates(ydot, nq, last, par, grip, diag):
+    """dz/dt of every free pin's bristle into ydot (after the loads); its stored energy
+    k_t z^2 / 2 joins the ground pads' and its dissipated power, -f v_t - k_t z dz/dt (the
+    power the pin puts in less what the spring stores: the dashpot's c (dz/dt)^2 and the
+    slip's mu p |v_t - dz/dt|), the dampers'."""
+    k = par[P_BRISTLE_K]
+    energy = 0.0
+    dissipation = 0.0
+    for b in range(1, last + 1):
+        z = grip[b, G_DEFLECTION]
+        rate = grip[b, G_RATE]
+        ydot[bristle_state(nq, b)] = rate
+        energy += 0.5 * k * z * z
+        dissipation += -grip[b, G_FORCE] * grip[b, G_SPEED] - k * z * rate
+    diag[D_E_PAD_GROUND] += energy
+    diag[D_DISSIPATION] += dissipation

@@ -16,7 +16,6 @@ from ..core.indices import (
     D_GROUND_FY,
     D_OBSTACLE_FORCE,
     D_POWER,
-    G_LIMIT,
     K_CORNER_LINK,
     K_CORNER_PIN,
     K_PIN_GROUND,
@@ -46,24 +45,18 @@ from .soil_jit import pin_on_soil, soil_shear
 @njit(**INLINE)
 def _ground_traction(b, apos, avel, t, p, par, soil, law, gripped):
     """The tangential force along the ground's unit tangent t on pin b pressed with p:
-    (force, its dissipated power, the mu left for the regularised Coulomb law of _push_pin,
-    gripped). law = (on soft soil, bristle law), decided once per call of _pins_on_ground.
-    On soft soil Janosi-Hanamoto's shear replaces friction; with the bristle law the pin's
-    first ground contact holds its bristle (later ones, at a concave corner, keep the
-    regularised law); otherwise the regularised law alone."""
+    (force, the mu left for the regularised Coulomb law of _push_pin, gripped). law = (on
+    soft soil, bristle law), decided once per call of _pins_on_ground. On soft soil
+    Janosi-Hanamoto's shear replaces friction; with the bristle law the pin's first ground
+    contact holds its bristle (later ones, at a concave corner, keep the regularised law);
+    otherwise the regularised law alone."""
     _, touchdown, _, grip = soil
     on_soil, bristle = law
     if on_soil:
-        return (
-            soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], t, p, par),
-            0.0,
-            0.0,
-            gripped,
-        )
+        return soil_shear(apos[b, 0], apos[b, 1], touchdown[b, 0], touchdown[b, 1], t, p, par), 0.0, gripped
     if bristle and not gripped:
-        ft, fd = pin_grip(b, apos, avel, t, p, par, touchdown, grip)
-        return ft, fd, 0.0, True
-    return 0.0, 0.0, par[P_FRICTION], gripped
+        return pin_grip(b, avel, t, p, par, grip), 0.0, True
+    return 0.0, par[P_FRICTION], gripped
 
 
 @njit(**INLINE)
@@ -84,14 +77,12 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
     first = rows[K_PIN_GROUND]
     on_soil = par[P_SOIL] != 0.0
     bristle = uses_bristle(par)
-    rut, _, sink, grip = soil
+    rut, _, sink, _ = soil
     gx, gy, corner_force, energy, power, obstacle, dissipation = acc
     for b in range(1, last + 1):
         row = first + b
         if on_soil:
             sink[b] = 0.0
-        if bristle:
-            grip[b, G_LIMIT] = np.nan
         gripped = False  # the bristle on the pin's first ground contact only
         if nbr[row, NB_COUNT] == 0:  # no ground within reach (the closed track's top run): no call
             continue
@@ -131,14 +122,13 @@ def _pins_on_ground(apos, avel, fpin, last, par, seg, nbr, rows, mem, soil, acc)
             else:
                 rate = -(avel[b, 0] * nx + avel[b, 1] * ny) if damped else 0.0
                 p, e, pd = _pad(plain, law, hg - s, rate, mem, row, partner)  # Eq. (6)
-            ft, fd, mu_left, gripped = _ground_traction(
+            ft, mu_left, gripped = _ground_traction(
                 b, apos, avel, (ny, -nx), p, par, soil, (on_soil, bristle), gripped
             )
             fx, fy = p * nx + ft * ny, p * ny - ft * nx
             if on_soil:  # what the soil takes counts as dissipated (its elastic rebound gives some back)
                 pd = -(fx * avel[b, 0] + fy * avel[b, 1])
             force = (fx, fy, p, e, pd)
-            dissipation += fd
             fr = (mu_left, v_eps)
             acc = (gx, gy, corner_force, energy, power, obstacle, dissipation)
             acc = _push_pin(fpin, avel, b, force, (0.0, 0.0), (ny, -nx), fr, acc, (0.0, p if sj > 0 else 0.0))

@@ -123,7 +123,7 @@ def paper_contact():
         "geometry": "paper",              # or "continuous"
         "friction": 0.0,                  # Coulomb mu between ground and track (0: the paper)
         "friction_velocity": 0.01,        # regularising speed of the friction law (m/s)
-        "friction_law": "regularised",    # or "bristle": a spring to an anchor that slips at mu p
+        "friction_law": "regularised",    # or "bristle": a spring and dashpot that slip at mu p
         "friction_stiffness": 2.0e7,      # the bristle's tangential stiffness per pin contact (N/m)
     }
 

@@ -53,13 +53,14 @@ from ...model.core.indices import (
     P_PAD_WHEEL,
     P_SOIL,
     P_WHEEL_RADIUS,
+    PN_NQ,
     Q_ARM,
     Q_PITCH,
     Q_X,
     Q_Y,
     SEG_LENGTH,
 )
-from ...model.core.indices_jit import nq_of, q_idler, q_pin, q_sprocket
+from ...model.core.indices_jit import q_idler, q_pin, q_sprocket
 from ...model.core.jit import BORROW, INLINE, KERNEL
 from ...model.dynamics.closed_track_jit import guide_offset, place_closed
 from ...model.ground.soil_jit import KINK_TOL, N_KINKS, soil_kink
@@ -369,7 +370,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     a kink of the same kind, or on soft soil a pin crosses a kink of the soil's pressure
     law (_soil_switch); 2.0 if none. ev: EventWork (the paper's layout) or ClosedEventWork
     (the closed one: the idler, rollers and teeth as well)."""
-    nq = nq_of(y0.shape[0])
+    nq = m.pins[PN_NQ]
     _place_ends(y0, y1, nq, m, ev)
     step = (y0, f0, y1, f1, h)
     ramp = m.par[P_DAMPING_RAMP] if m.par[P_CONTACT_DAMPING] == DAMPING_VISCOUS else -1.0

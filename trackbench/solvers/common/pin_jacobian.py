@@ -74,7 +74,7 @@ def ring_colours(n, closed, reach=2):
 def jacobian_work(model, ny):
     """The blocks of the model's free pins (the closed track's every pin, the paper's pins
     1..n-1) and the scratch of the finite differences and factors."""
-    nq = L.nq_of(ny)
+    nq = model.nq
     n_pins = model.n_links if model.closed else model.n_links - 1
     blk = np.empty((n_pins, 4), dtype=np.int64)
     for i in range(n_pins):

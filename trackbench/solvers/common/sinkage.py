@@ -20,9 +20,9 @@ from ...model.core.indices import (
     P_RUT_X0,
     P_SOIL,
     PN_LAST,
+    PN_NQ,
     SEG_LENGTH,
 )
-from ...model.core.indices_jit import nq_of
 from ...model.core.jit import BORROW
 from ...model.ground.soil_jit import raise_memory
 from .events import BISECTIONS, _pin_at
@@ -108,7 +108,7 @@ def remember_inside_step(y0, f0, y1, f1, h, m, ev, end):
     sinkage inside the step where it turned there (soil_jit.raise_memory at that point)."""
     if m.par[P_SOIL] == 0.0:
         return
-    nq = nq_of(y0.shape[0])
+    nq = m.pins[PN_NQ]
     step = (y0, f0, y1, f1, h)
     n_links = ev.pins0.shape[0] - 1
     for i in range(1, m.pins[PN_LAST] + 1):

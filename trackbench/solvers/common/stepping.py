@@ -11,8 +11,7 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import remember_onsets
-from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_GRIP, Q_X, S_E0, Y_WORK
-from ...model.core.indices_jit import nq_of
+from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_Y_EXTRA, PN_NQ, Q_X, S_E0, Y_WORK
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import remember_ground
@@ -21,15 +20,14 @@ from .arrays import copy_into, set_row
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
 
-# What the soil's and the bristles' memories are moved from after an accepted step (Work's
-# fields of the same names, at the step's end), kept while the output samples inside the step
-# are evaluated: the step was integrated with the memories as they were before it, and so are
-# its samples.
-EndOfStep = namedtuple("EndOfStep", ["apos", "sink", "grip"])
+# What the soil's memory is moved from after an accepted step (Work's fields of the same
+# names, at the step's end), kept while the output samples inside the step are evaluated: the
+# step was integrated with the memory as it was before it, and so are its samples.
+EndOfStep = namedtuple("EndOfStep", ["apos", "sink"])
 
 
 def end_of_step(n_pins):
-    return EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins), np.full((n_pins, N_GRIP), np.nan))
+    return EndOfStep(np.zeros((n_pins, 2)), np.zeros(n_pins))
 
 
 @njit(**INLINE)
@@ -38,16 +36,13 @@ def keep_end(w, end):
         end.apos[b, 0] = w.apos[b, 0]
         end.apos[b, 1] = w.apos[b, 1]
         end.sink[b] = w.sink[b]
-        for k in range(N_GRIP):
-            end.grip[b, k] = w.grip[b, k]
 
 
 @njit(**BORROW)
 def loop_first(y0, m, w, lw, out):
     """t = 0: the first derivative (row 0 of K), the energy references, the first sample.
     Returns (status, e_ref, r_ref)."""
-    ny = y0.shape[0]
-    nq = nq_of(ny)
+    nq = m.pins[PN_NQ]
     copy_into(lw.y, 0, y0)
     rhs(lw.y, m, w, lw.K[0], lw.diag)
     e_ref = energy_balance(lw.diag)
@@ -69,7 +64,7 @@ def samples(t, h, n_out, dt_out, m, w, lw, out):
     """Output samples in (t, t + h] by Hermite interpolation; returns the new sample count."""
     y, K, y_new, ys, fs = lw.y, lw.K, lw.y_new, lw.ys, lw.fs
     out_y, out_diag = out.y, out.diag
-    nq = nq_of(y.shape[0])
+    nq = m.pins[PN_NQ]
     s = K.shape[0] - 1
     t_new = t + h
     while n_out < out_y.shape[0] and n_out * dt_out <= t_new * (1.0 + 1e-12):
@@ -94,11 +89,21 @@ def accepted_status(y_new, diag):
 
 
 @njit(**INLINE)
-def error_norm(y, y_new, er, rtol, atol, n):
-    """RMS norm of an error estimate er over the first n components (q, qd): the
-    linearly implicit methods' (the explicit pairs' own, rk_loop.py, folds in h)."""
+def _squares(y, y_new, er, rtol, atol, lo, hi):
     s = 0.0
-    for k in range(n):
+    for k in range(lo, hi):
         sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
         s += (er[k] / sc) ** 2
-    return math.sqrt(s / n)
+    return s
+
+
+@njit(**INLINE)
+def error_norm(y, y_new, er, rtol, atol, n):
+    """RMS norm of an error estimate er over the first n components (q, qd) and the bristle
+    deflections after the extras: the linearly implicit methods' (the explicit pairs' own,
+    rk_loop.py, folds in h)."""
+    ny = y.shape[0]
+    s = _squares(y, y_new, er, rtol, atol, 0, n)
+    if ny > n + N_Y_EXTRA:   # the bristle law's states
+        s += _squares(y, y_new, er, rtol, atol, n + N_Y_EXTRA, ny)
+    return math.sqrt(s / (ny - N_Y_EXTRA))

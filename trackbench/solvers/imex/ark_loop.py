@@ -20,8 +20,7 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step, remember_onsets
-from ...model.core.indices import Q_X, Y_WORK
-from ...model.core.indices_jit import nq_of
+from ...model.core.indices import PN_NQ, Q_X, Y_WORK
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import has_ground_memory, remember_ground
@@ -88,7 +87,7 @@ def _step(h, tab, m, w, lw, jw):
     estimate. Returns the right-hand sides it took."""
     y, y_new, er, K = lw.y, lw.y_new, lw.er, lw.K
     n = y.shape[0]
-    nq = nq_of(n)
+    nq = m.pins[PN_NQ]
     s = tab.b.shape[0]
     factor(h * tab.gamma, jw)
     for k in range(n):
@@ -117,13 +116,13 @@ def _step(h, tab, m, w, lw, jw):
 def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
     y, y_new, K, peaks = lw.y, lw.y_new, lw.K, out.peaks
     ny = y0.shape[0]
-    nq = nq_of(ny)
+    nq = m.pins[PN_NQ]
     s = tab.b.shape[0]
     status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
     h = min(ctl.h0, ctl.h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
-    memory = has_ground_memory(m.par)   # soil or bristles: their memories move after each accepted step
+    memory = has_ground_memory(m.par)   # soil: its memory moves after each accepted step
     age_limit, renew_after = jw.reuse[0], jw.reuse[1]
     age = age_limit   # no Jacobian yet
     in_row = 0        # rejections in a row

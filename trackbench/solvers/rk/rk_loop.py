@@ -13,8 +13,7 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step, remember_onsets
-from ...model.core.indices import Q_X, Y_WORK
-from ...model.core.indices_jit import nq_of
+from ...model.core.indices import N_Y_EXTRA, PN_NQ, Q_X, Y_WORK
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import has_ground_memory, remember_ground
@@ -66,34 +65,49 @@ def _combine(y, h, w, K, m, out):
 
 
 @njit(**INLINE)
-def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
-    """RMS norm of the embedded error estimate over the first n components
-    (Hairer's DOP853 combination when e3 is given)."""
+def _error_sums(y, y_new, K, e, e3, rtol, atol, lo, hi, er5, er3):
+    """Sums of the squared scaled error estimates (5th order, 3rd order when e3 is given)
+    over the components lo..hi-1."""
     use3 = e3[0] != 0.0
-    for k in range(n):
+    for k in range(lo, hi):
         er5[k] = 0.0
         er3[k] = 0.0
     for j in range(K.shape[0]):
         if e[j] != 0.0:
             ej = e[j]
-            for k in range(n):
+            for k in range(lo, hi):
                 er5[k] += ej * K[j, k]
         if use3 and e3[j] != 0.0:
             ej = e3[j]
-            for k in range(n):
+            for k in range(lo, hi):
                 er3[k] += ej * K[j, k]
     s5 = 0.0
     s3 = 0.0
-    for k in range(n):
+    for k in range(lo, hi):
         sc = atol + rtol * max(abs(y[k]), abs(y_new[k]))
         s5 += (er5[k] / sc) ** 2
         s3 += (er3[k] / sc) ** 2
-    if use3:
+    return s5, s3
+
+
+@njit(**INLINE)
+def _error_norm(y, y_new, K, e, e3, h, rtol, atol, n, er5, er3):
+    """RMS norm of the embedded error estimate over the second-order states (q, qd), the
+    first n components, and the bristle deflections after the extras (Hairer's DOP853
+    combination when e3 is given); the extras (W, D, the drive's) are left out."""
+    ny = y.shape[0]
+    s5, s3 = _error_sums(y, y_new, K, e, e3, rtol, atol, 0, n, er5, er3)
+    if ny > n + N_Y_EXTRA:   # the bristle law's states (a separate call: the loops above stay as fast)
+        z5, z3 = _error_sums(y, y_new, K, e, e3, rtol, atol, n + N_Y_EXTRA, ny, er5, er3)
+        s5 += z5
+        s3 += z3
+    n_err = ny - N_Y_EXTRA
+    if e3[0] != 0.0:
         den = s5 + 0.01 * s3
         if den <= 0.0:
             return 0.0
-        return abs(h) * s5 / math.sqrt(den * n)
-    return abs(h) * math.sqrt(s5 / n)
+        return abs(h) * s5 / math.sqrt(den * n_err)
+    return abs(h) * math.sqrt(s5 / n_err)
 
 
 @njit(**INLINE)
@@ -115,20 +129,20 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     peaks = out.peaks
     rtol, atol, h_min, h_max, t_end = ctl.rtol, ctl.atol, ctl.h_min, ctl.h_max, ctl.t_end
     ny = y0.shape[0]
-    nq = nq_of(ny)
+    nq = m.pins[PN_NQ]
     s = b.shape[0]
     status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
     h = min(ctl.h0, h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
-    memory = has_ground_memory(m.par)   # soil or bristles: their memories move after each accepted step
+    memory = has_ground_memory(m.par)   # soil: its memory moves after each accepted step
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
             break
         _stages(h, A, b, m, w, y, K, ys, y_new, diag)
         n_rhs += s
-        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, 2 * nq, er5, er3)  # (q, qd): W and D follow
+        err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, 2 * nq, er5, er3)  # (q, qd), bristles
         if not (err <= 1.0):  # also catches NaN
             rejected += 1
             th = 2.0

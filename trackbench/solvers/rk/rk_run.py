@@ -9,6 +9,8 @@ from .tableau import TABLEAUS
 
 
 def run(scenario, model, y0):
+    if y0.size != model.ny:   # the kernels index y by the model's layout, unchecked
+        raise ValueError(f"the state has {y0.size} components, the model's layout {model.ny}")
     tab = TABLEAUS[scenario["method"]].arrays()
     out = allocate_outputs(scenario, model, y0.size)
     lw = loop_arrays(tab.b.shape[0], y0.size, L.n_diag(model.nw, model.n_links), model.n_links + 1)
