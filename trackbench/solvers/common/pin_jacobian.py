@@ -1,7 +1,8 @@
 """The Jacobian J the IMEX pairs solve with (solvers/imex: their implicit part J y): one
-dense block per pin over the pin's own state components (x, y, vx, vy), its velocity
-columns from finite differences of the whole right-hand side, and the exact kinematic
-identity d q / dt = qd for every coordinate.
+dense block per pin over the pin's own state components (x, y, vx, vy) and, with the
+bristle law, its bristle's deflection z; the velocity (and z) columns from finite differences
+of the whole right-hand side, and the exact kinematic identity d q / dt = qd for every
+coordinate.
 
 Why per pin: what limits an explicit step on the driven vehicle is local to each pin: the
 regularised Coulomb law holding a loaded pin stuck (a damper mu p / (v_eps m_pin), up to
@@ -32,6 +33,7 @@ from .arrays import copy_into
 N_KINEMATIC = 2   # a block's first rows are positions: d (x, y) / dt = (vx, vy), exact
 SQRT_EPS = math.sqrt(np.finfo(float).eps)
 SCALE_VELOCITY = 1e-1   # m/s: the least velocity (1.5e-9 m/s, well inside v_eps = 0.01 m/s)
+SCALE_DEFLECTION = 1e-3   # m: the least bristle deflection (1.5e-11 m; mu p / k_t is ~3e-3 m)
 
 JacobianWork = namedtuple("JacobianWork", [
     "blk",      # (n_pins, nb) the state indices of each pin's block: x, y, vx, vy
@@ -76,14 +78,17 @@ def jacobian_work(model, ny):
     1..n-1) and the scratch of the finite differences and factors."""
     nq = model.nq
     n_pins = model.n_links if model.closed else model.n_links - 1
-    blk = np.empty((n_pins, 4), dtype=np.int64)
+    bristles = model.has_bristles   # the bristle's deflection z joins its pin's block
+    blk = np.empty((n_pins, 5 if bristles else 4), dtype=np.int64)
     for i in range(n_pins):
         k = L.q_pin(model.nw, i + 1)
-        blk[i] = (k, k + 1, nq + k, nq + k + 1)
+        blk[i, :4] = (k, k + 1, nq + k, nq + k + 1)
+        if bristles:
+            blk[i, 4] = L.bristle_state(nq, i + 1)
     in_block = set(blk[:, :N_KINEMATIC].ravel().tolist())
     free = np.array([k for k in range(nq) if k not in in_block], dtype=np.int64)
     nb = blk.shape[1]
-    scale = np.array([0.0, 0.0, SCALE_VELOCITY, SCALE_VELOCITY])
+    scale = np.array([0.0, 0.0, SCALE_VELOCITY, SCALE_VELOCITY, SCALE_DEFLECTION][:nb])
     return JacobianWork(blk, ring_colours(n_pins, model.closed), free, scale, np.zeros((n_pins, nb, nb)),
                         np.zeros((n_pins, nb, nb)), np.zeros((n_pins, nb), dtype=np.int64), np.zeros(n_pins),
                         np.empty(ny), np.empty(ny), np.empty(nb), np.array([J_AGE, J_REJECTIONS]))
