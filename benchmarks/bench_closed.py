@@ -226,20 +226,6 @@ def cost():
         )
 
 
-def precision(vs=None, repeats=REPEATS):
-    """Work against precision of MODELS (benchmarks/work_precision.py): cost, and deviation from
-    dopri5 at 1e-11, of each (method, tolerance) of `vs` (default: the registry's methods at
-    work_precision.TOLERANCES)."""
-    for name, model in MODELS.items():
-        work_precision.precision(name, model, vs or work_precision.variants(), repeats)
-
-
-def spread(vs=None):
-    """The spread of MODELS' peaks over tolerances and nudges, for each (method, tolerance)."""
-    for name, model in MODELS.items():
-        work_precision.spread(name, model, vs or work_precision.variants())
-
-
 PARTS = {
     "rest": rest,
     "drive": drive,
@@ -247,16 +233,7 @@ PARTS = {
     "traction": traction,
     "step": step,
     "cost": cost,
-    "precision": precision,
-    "spread": spread,
 }
 
 if __name__ == "__main__":
-    names, vs, repeats = work_precision.command_line(sys.argv[1:], PARTS)
-    for name in names:
-        if name == "precision":
-            precision(vs, repeats)
-        elif name == "spread":
-            spread(vs)
-        else:
-            PARTS[name]()
+    work_precision.main(sys.argv[1:], PARTS, MODELS)

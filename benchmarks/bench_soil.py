@@ -119,34 +119,12 @@ def slip_curve(slips=(0.05, 0.1, 0.2, 0.3, 0.4, 0.5), link_stiffness=None, durat
         )
 
 
-def precision(vs=None, repeats=REPEATS):
-    """Work against precision of MODELS: cost, and deviation from dopri5 at 1e-11, of each
-    (method, tolerance) of `vs` (default: the registry's methods at work_precision.TOLERANCES)."""
-    for name, model in MODELS.items():
-        work_precision.precision(name, model, vs or work_precision.variants(), repeats)
-
-
-def spread(vs=None):
-    """The spread of MODELS' peaks over tolerances and nudges, for each (method, tolerance)."""
-    for name, model in MODELS.items():
-        work_precision.spread(name, model, vs or work_precision.variants())
-
-
 PARTS = {
     "cost": cost,
     "soils": soils,
     "slips": slip_curve,
     "stiff_slips": lambda: slip_curve(link_stiffness=8e7),  # Wong's track is inextensible: test_drawbar's
-    "precision": precision,
-    "spread": spread,
 }
 
 if __name__ == "__main__":
-    names, vs, repeats = work_precision.command_line(sys.argv[1:], PARTS)
-    for name in names:
-        if name == "precision":
-            precision(vs, repeats)
-        elif name == "spread":
-            spread(vs)
-        else:
-            PARTS[name]()
+    work_precision.main(sys.argv[1:], PARTS, MODELS)

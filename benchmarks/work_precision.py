@@ -63,7 +63,6 @@ NUDGE = 1e-9  # m: the scenario's perturbation of the spread's nudged runs
 NUDGE_SEEDS = (1, 2, 3)
 SPREAD_DIVISORS = (1, 10, 100)
 CACHE = Path(__file__).resolve().parent / ".cache"
-COUNT_WORDS = ("_evaluations", "jacobian", "decomposition")
 _RUNS = {}  # scenario (JSON) -> figures, shared by the parts
 _WARM = set()  # (model, method) compiled and loaded
 
@@ -101,17 +100,6 @@ def _label(column):
     return q.heading.format(wheel).rsplit(" ", 1)[0] if q.heading else column
 
 
-def _other_counts(ds):
-    """Counts beyond steps and right-hand sides a solver reports (attrs or scalar variables)."""
-    scalars = {k: ds[k].values.item() for k in ds.data_vars if ds[k].ndim == 0}
-    out = {}
-    for k, v in {**ds.attrs, **scalars}.items():
-        counted = k != "rhs_evaluations" and any(w in k for w in COUNT_WORDS)
-        if counted and isinstance(v, (int, float)) and math.isfinite(v) and v == int(v):
-            out[k] = int(v)
-    return out
-
-
 def _figures(ds, sc, wall):
     a = ds.attrs
     t = ds.time.values
@@ -124,7 +112,6 @@ def _figures(ds, sc, wall):
         "steps": a["steps"],
         "rejected": a["rejected_steps"],
         "rhs": a["rhs_evaluations"],
-        "other_counts": _other_counts(ds),
         "solve": a["solve_time"],
         "wall": wall,
         "summary": quantities.without_nan(quantities.values(ds, times=False)),
@@ -251,10 +238,6 @@ def _row(cells):
     return "| " + " | ".join(cells) + " |"
 
 
-def _counts(fig):
-    return ", ".join(f"{k} {v}" for k, v in fig["other_counts"].items()) or "-"
-
-
 def _line(name, fig, ref, first_solve):
     devs = deviations(fig, ref) if ref is not None else ["-", "(ref)", "-", "-", "(ref)"]
     return _row(
@@ -272,7 +255,6 @@ def _line(name, fig, ref, first_solve):
             *devs,
             f"{fig['energy']:.1e}",
             f"{fig['speed_hold']:.2e}",
-            _counts(fig),
         ]
     )
 
@@ -295,7 +277,6 @@ HEAD = (
     "worst end",
     "energy res",
     "speed hold",
-    "other counts",
 )
 
 
@@ -382,3 +363,17 @@ def spread(name, model, vs):
     for cells in rows:
         print(_row(cells))
     print(f"\npart took {time.perf_counter() - t0:.0f} s")
+
+
+def main(argv, parts, models):
+    """Run a benchmark script's parts named on its command line; the "precision" and "spread"
+    parts run precision() and spread() on each of `models` (name -> scenario overrides)."""
+    names, vs, repeats = command_line(argv, [*parts, "precision", "spread"])
+    for name in names:
+        if name in parts:
+            parts[name]()
+        for label, model in models.items():
+            if name == "precision":
+                precision(label, model, vs, repeats)
+            elif name == "spread":
+                spread(label, model, vs)

@@ -48,7 +48,6 @@ JacobianWork = namedtuple("JacobianWork", [
     "yp",       # (ny,) perturbed state
     "fp",       # (ny,) its derivative
     "rb",       # (nb,) one block's right-hand side
-    "reuse",    # (2,) accepted steps one Jacobian serves at most; rejections in a row that renew it
 ])
 
 J_AGE = 20           # accepted steps one Jacobian serves at most
@@ -91,7 +90,7 @@ def jacobian_work(model, ny):
     scale = np.array([0.0, 0.0, SCALE_VELOCITY, SCALE_VELOCITY, SCALE_DEFLECTION][:nb])
     return JacobianWork(blk, ring_colours(n_pins, model.closed), free, scale, np.zeros((n_pins, nb, nb)),
                         np.zeros((n_pins, nb, nb)), np.zeros((n_pins, nb), dtype=np.int64), np.zeros(n_pins),
-                        np.empty(ny), np.empty(ny), np.empty(nb), np.array([J_AGE, J_REJECTIONS]))
+                        np.empty(ny), np.empty(ny), np.empty(nb))
 
 
 @njit(**INLINE)

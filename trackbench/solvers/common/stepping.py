@@ -1,8 +1,9 @@
 """What the compiled time loops of the reduced state share around their steps: the start at
-t = 0, the output samples inside an accepted step (Hermite interpolation between the step's
-ends), the status of an accepted state, and the ground's state at a step's end kept while
-the samples are evaluated. A loop's scratch bundle has the fields y, y_new, ys, fs, diag and
-K (row 0: f at the step's start; last row: f at its end)."""
+t = 0, what follows an accepted step (its status, peaks, output samples by Hermite
+interpolation between the step's ends, the memories moved, the end made the next start), and
+the ground's state at a step's end kept while the samples are evaluated. A loop's scratch
+bundle has the fields y, y_new, ys, fs, diag, end and K (row 0: f at the step's start; last
+row: f at its end)."""
 
 import math
 from collections import namedtuple
@@ -14,11 +15,12 @@ from ...model.contact.onsets import remember_onsets
 from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_Y_EXTRA, PN_NQ, Q_X, S_E0, Y_WORK
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
-from ...model.ground.memory import remember_ground
+from ...model.ground.memory import has_ground_memory, remember_ground
 from ...status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
+from .sinkage import remember_inside_step
 
 # What the soil's memory is moved from after an accepted step (Work's fields of the same
 # names, at the step's end), kept while the output samples inside the step are evaluated: the
@@ -107,3 +109,29 @@ def error_norm(y, y_new, er, rtol, atol, n):
     if ny > n + N_Y_EXTRA:   # the bristle law's states
         s += _squares(y, y_new, er, rtol, atol, n + N_Y_EXTRA, ny)
     return math.sqrt(s / (ny - N_Y_EXTRA))
+
+
+@njit(**INLINE)
+def accept_step(t, h, n_out, step_refs, m, w, ev, lw, ctl, out):
+    """After the step from t to t + h was accepted: its status, the peaks (step_refs = (at_switch,
+    e_ref, r_ref)), the approach speeds, the output samples inside it, the ground's memories
+    (after the samples: they were integrated with the memories as they were), and y_new, f(y_new)
+    as the next step's start. Returns (status, the new sample count)."""
+    at_switch, e_ref, r_ref = step_refs
+    y, y_new, K, diag = lw.y, lw.y_new, lw.K, lw.diag
+    nq = m.pins[PN_NQ]
+    s = K.shape[0] - 1
+    memory = has_ground_memory(m.par)   # soil: its memory moves after each accepted step
+    status = accepted_status(y_new, diag)
+    update_peaks(out.peaks, t + h, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
+    remember_onsets(m, w)
+    if memory:
+        keep_end(w, lw.end)
+    n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
+    if memory:
+        remember_inside_step(y, K[0], y_new, K[s], h, m, ev, lw.end)   # the soil's, along the step
+        remember_ground(m, lw.end)  # from the accepted end state, after the samples inside the step
+    for k in range(y.shape[0]):
+        y[k] = y_new[k]
+        K[0, k] = K[s, k]
+    return status, n_new

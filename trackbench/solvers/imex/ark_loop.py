@@ -19,11 +19,10 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ...model.contact.onsets import onset_in_step, remember_onsets
-from ...model.core.indices import PN_NQ, Q_X, Y_WORK
+from ...model.contact.onsets import onset_in_step
+from ...model.core.indices import PN_NQ
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
-from ...model.ground.memory import has_ground_memory, remember_ground
 from ...status import SUCCESSFUL
 from ..common.control import (
     FAC_MAX,
@@ -35,10 +34,8 @@ from ..common.control import (
     loop_start,
 )
 from ..common.events import first_contact_switch
-from ..common.monitor import update_peaks
-from ..common.pin_jacobian import factor, pin_jacobian, solve, times_j
-from ..common.sinkage import remember_inside_step
-from ..common.stepping import accepted_status, end_of_step, error_norm, keep_end, loop_first, samples
+from ..common.pin_jacobian import J_AGE, J_REJECTIONS, factor, pin_jacobian, solve, times_j
+from ..common.stepping import accept_step, end_of_step, error_norm, loop_first
 
 ArkWork = namedtuple("ArkWork", [
     "K",      # (stages + 1, ny) F_i = f(y + Z_i); row 0 f at the step's start, the last f at its end
@@ -114,23 +111,20 @@ def _step(h, tab, m, w, lw, jw):
 
 @njit(**BORROW)
 def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
-    y, y_new, K, peaks = lw.y, lw.y_new, lw.K, out.peaks
-    ny = y0.shape[0]
+    y, y_new, K = lw.y, lw.y_new, lw.K
     nq = m.pins[PN_NQ]
     s = tab.b.shape[0]
     status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
     h = min(ctl.h0, ctl.h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
-    memory = has_ground_memory(m.par)   # soil: its memory moves after each accepted step
-    age_limit, renew_after = jw.reuse[0], jw.reuse[1]
-    age = age_limit   # no Jacobian yet
+    age = J_AGE       # no Jacobian yet
     in_row = 0        # rejections in a row
     while status == SUCCESSFUL and t < ctl.t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, ctl.t_end, steps, rejected, ctl.max_steps, ctl.h_min)
         if status != SUCCESSFUL:
             break
-        if age >= age_limit or in_row >= renew_after:
+        if age >= J_AGE or in_row >= J_REJECTIONS:
             n_rhs += pin_jacobian(y, K[0], m, w, jw, lw.diag)
             age = 0
             in_row = 0
@@ -154,24 +148,12 @@ def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
                 at_switch = True
                 fac_max = 1.0
                 continue
-        t_new = t + h
         steps, h_lo, h_hi = counted(h, steps, h_lo, h_hi)
-        status = accepted_status(y_new, lw.diag)
-        update_peaks(peaks, t_new, lw.diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
+        status, n_new = accept_step(t, h, n_out, (at_switch, e_ref, r_ref), m, w, ev, lw, ctl, out)
         at_switch = False
-        remember_onsets(m, w)
-        if memory:
-            keep_end(w, lw.end)
-        n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
-        if memory:
-            remember_inside_step(y, K[0], y_new, K[s], h, m, ev, lw.end)   # the soil's, along the step
-            remember_ground(m, lw.end)
         n_rhs += n_new - n_out
         n_out = n_new
-        t = t_new
-        for k in range(ny):
-            y[k] = y_new[k]
-            K[0, k] = K[s, k]
+        t += h
         h = after_acceptance(h, err, tab.expo, fac_max, ctl.h_max)
         fac_max = FAC_MAX
         age += 1

@@ -12,11 +12,10 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-from ...model.contact.onsets import onset_in_step, remember_onsets
-from ...model.core.indices import N_Y_EXTRA, PN_NQ, Q_X, Y_WORK
+from ...model.contact.onsets import onset_in_step
+from ...model.core.indices import N_Y_EXTRA, PN_NQ
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
-from ...model.ground.memory import has_ground_memory, remember_ground
 from ...status import SUCCESSFUL
 from ..common.control import (
     FAC_MAX,
@@ -28,9 +27,7 @@ from ..common.control import (
     loop_start,
 )
 from ..common.events import first_contact_switch
-from ..common.monitor import update_peaks
-from ..common.sinkage import remember_inside_step
-from ..common.stepping import accepted_status, end_of_step, keep_end, loop_first, samples
+from ..common.stepping import accept_step, end_of_step, loop_first
 
 RkWork = namedtuple("RkWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
@@ -126,16 +123,13 @@ def _stages(h, A, b, m, w, y, K, ys, y_new, diag):
 def integrate(y0, ctl, tab, m, w, ev, lw, out):
     A, b, e, e3, expo = tab.A, tab.b, tab.e, tab.e3, tab.expo
     K, y, y_new, ys, er5, er3, diag = lw.K, lw.y, lw.y_new, lw.ys, lw.er5, lw.er3, lw.diag
-    peaks = out.peaks
     rtol, atol, h_min, h_max, t_end = ctl.rtol, ctl.atol, ctl.h_min, ctl.h_max, ctl.t_end
-    ny = y0.shape[0]
     nq = m.pins[PN_NQ]
     s = b.shape[0]
     status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
     h = min(ctl.h0, h_max)
     n_rhs = n_out = 1
     t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
-    memory = has_ground_memory(m.par)   # soil: its memory moves after each accepted step
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
@@ -162,24 +156,12 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
                 at_switch = True
                 fac_max = 1.0
                 continue
-        t_new = t + h
         steps, h_lo, h_hi = counted(h, steps, h_lo, h_hi)
-        status = accepted_status(y_new, diag)
-        update_peaks(peaks, t_new, diag, y_new[nq + Q_X], y_new[2 * nq + Y_WORK], e_ref, r_ref, at_switch)
+        status, n_new = accept_step(t, h, n_out, (at_switch, e_ref, r_ref), m, w, ev, lw, ctl, out)
         at_switch = False
-        remember_onsets(m, w)
-        if memory:
-            keep_end(w, lw.end)
-        n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
-        if memory:
-            remember_inside_step(y, K[0], y_new, K[s], h, m, ev, lw.end)   # the soil's, along the step
-            remember_ground(m, lw.end)  # from the accepted end state, after the samples inside the step
         n_rhs += n_new - n_out
         n_out = n_new
-        t = t_new
-        for k in range(ny):
-            y[k] = y_new[k]
-            K[0, k] = K[s, k]
+        t += h
         h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX
     finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)
