@@ -10,7 +10,8 @@ from trackbench import output, quantities
 from trackbench.quantities import run_summary
 from trackbench.replay.plots import study_axes
 
-SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1"}
+SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1",
+         "g": "1", "W": "W", "m/s^1.75": "m s-1.75"}
 
 
 def test_the_table_matches_the_dataset(paper_run_short):
@@ -86,6 +87,11 @@ def test_summary_columns_in_the_documented_order():
         "min_chassis_ay_time",
         "min_chassis_vx",
         "min_chassis_vx_time",
+        "peak_seat_acceleration_g",
+        "peak_seat_acceleration_g_time",
+        "absorbed_power",
+        "weighted_rms_acceleration",
+        "vdv",
         "first_contact_time",
         "first_compression_time",
         "max_energy_balance_error",
@@ -97,6 +103,10 @@ def test_summary_columns_in_the_documented_order():
         "peak_chassis_ay",
         "min_chassis_ay",
         "min_chassis_vx",
+        "peak_seat_acceleration_g",
+        "absorbed_power",
+        "weighted_rms_acceleration",
+        "vdv",
     ]
 
 

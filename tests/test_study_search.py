@@ -131,6 +131,8 @@ duration = 0.02
 output_interval = 0.001
 record = { enabled = false }
 terrain = { kind = "step", height = 0.1, first_contact_time = 0.005 }
+"track.layout" = "closed"
+"drive.kind" = "speed"
 [grid]
 "terrain.height" = [0.05, 0.1]
 [search]
@@ -161,6 +163,11 @@ limit = 7e5
     ('quantity = "peak_wheel1_force_y"', 'quantity = "peak_sinkage"', "of runs with soft soil only"),
     ("limit = 7e5", "limt = 7e5", "[search]: unknown key 'limt'; did you mean limit?"),
     ("low = 2.0\n", "", "[search] lacks low: it needs parameter, low, high, tolerance, quantity, limit"),
+    ('"track.layout" = "closed"\n"drive.kind" = "speed"\n', "",
+     "[search] parameter = speed needs the speed held, but the paper's bolted track coasts; allowed: "
+     'track.layout = "closed" with drive.kind = "speed"'),
+    ('"drive.kind" = "speed"', '"drive.kind" = "torque"\n"drive.torque" = 1000.0',
+     "needs the speed held, but drive.kind = 'torque'"),
     ('name = "lim"', 'name = "lim"\nreplicates = 2', "replicates = 2 is not allowed with it"),
 ])
 def test_bad_search_tables_fail_in_one_line(tmp_path, old, new, message):

@@ -49,6 +49,10 @@ def _motion(model, result, placed):
         "chassis_vy": _var(T, qd[:, L.Q_Y], "m s-1", "chassis mass-centre vertical velocity"),
         "chassis_ax": _var(T, d[:, L.D_CHASSIS_AX], "m s-2", "chassis mass-centre horizontal acceleration"),
         "chassis_ay": _var(T, d[:, L.D_CHASSIS_AY], "m s-2", "chassis mass-centre vertical acceleration"),
+        "chassis_pitch_rate": _var(T, qd[:, L.Q_PITCH], "rad s-1", "chassis pitch rate"),
+        "chassis_pitch_acceleration": _var(
+            T, d[:, L.D_CHASSIS_ALPHA], "rad s-2", "chassis pitch acceleration"
+        ),
         "arm_angle": _var(
             WH,
             q[:, L.Q_ARM : L.Q_ARM + nw],
@@ -72,6 +76,39 @@ def _motion(model, result, placed):
             "N",
             "link tension, Eq. (8) (with the link dashpot if any); negative is compression",
         ),
+    }
+
+
+def _seat(scenario, result, nq):
+    """The driver's seat: its vertical acceleration and the ride metrics read from it
+    (ride_metrics.py; results_schema.md says over which samples). The metrics are NaN
+    where they cannot be had: samples more than 1/250 s apart (the weightings reach 100 Hz),
+    fewer than two, or not finite (a failed run)."""
+    from .ride_metrics import MIN_RATE, ride_figures, seat_acceleration
+
+    q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
+    v = scenario["vehicle"]
+    a = seat_acceleration(d[:, L.D_CHASSIS_AY], d[:, L.D_CHASSIS_ALPHA], qd[:, L.Q_PITCH],
+                          v["seat_x"], v["seat_y"], q[:, L.Q_PITCH])
+    dt = scenario["output_interval"]
+    nan = float("nan")
+    names = ("peak_seat_acceleration_g", "absorbed_power", "weighted_rms_acceleration", "vdv")
+    fig = dict.fromkeys(names, nan)
+    peak_time = nan
+    if dt <= 1.0 / MIN_RATE and a.shape[0] >= 2 and np.isfinite(a).all():
+        fig = ride_figures(a, dt, 0.5 * float(result.time[-1]))
+        peak_time = float(result.time[fig.pop("peak_index")])
+    text = "the seat's (vehicle.seat_x, seat_y) vertical acceleration, gravity not included"
+    return {
+        "seat_acceleration_y": _var(T, np.asarray(a), "m s-2", text),
+        "peak_seat_acceleration_g": _var((), fig["peak_seat_acceleration_g"], "1",
+                                         "max |seat acceleration| after a 30 Hz low-pass, in g"),
+        "peak_seat_acceleration_g_time": _var((), peak_time, "s", "time of peak_seat_acceleration_g"),
+        "absorbed_power": _var((), fig["absorbed_power"], "W",
+                               "vertical absorbed power at the seat (Pradko and Lee), 2nd half"),
+        "weighted_rms_acceleration": _var((), fig["weighted_rms_acceleration"], "m s-2",
+                                          "ISO 2631-1 Wk-weighted RMS seat acceleration, 2nd half"),
+        "vdv": _var((), fig["vdv"], "m s-1.75", "vibration dose value (Wk-weighted), 2nd half"),
     }
 
 
@@ -206,7 +243,6 @@ def _attrs(scenario, model, eq, ground, resolved, st, wall_time, solve_time):
         "weight": float(model.weight),
         "scenario": json.dumps(scenario.to_dict(), sort_keys=True),
         "terrain_resolved": json.dumps(resolved),
-        "ground_vertices": json.dumps(np.round(ground.vertices, 12).tolist()),
         "equilibrium": json.dumps(eq.summary()),
         "arm_pivots": json.dumps(model.arms[:, [L.ARMS_PX, L.ARMS_PY]].tolist()),
         "track_ends": json.dumps(model.ends.tolist()),
@@ -224,6 +260,7 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     placed = _place(model, result.y[:, :model.nq])
     v = _motion(model, result, placed)
     v.update(_energies(result, model.nq))
+    v.update(_seat(scenario, result, model.nq))
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
         v.update(closed_layout_vars(model, result, scenario, placed))
@@ -256,6 +293,9 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
             "track link number (joins pins b and b+1; link 0 joins the last pin and pin 1)",
         )
         attrs.update(closed_attrs(scenario))
+    gv = ("ground_vertex",)
+    v["ground_x"] = _var(gv, ground.vertices[:, 0], "m", "x of the ground polyline's vertices")
+    v["ground_y"] = _var(gv, ground.vertices[:, 1], "m", "height of the ground polyline's vertices")
     if rut_x is not None:
         coords["rut_x"] = _var(("rut_x",), rut_x, "m", "x of the soil's memory cells (centres)")
     return xr.Dataset(v, coords=coords, attrs=attrs)

@@ -194,35 +194,67 @@ def peak_seat_acceleration_g(a, dt, settle=0.0):
     return max_abs(y, start) / G
 
 
+def legacy_lowpass(a, dt):
+    """a (m/s^2) after peak_seat_acceleration_g's 30 Hz low-pass, from rest (m/s^2)."""
+    return _filtered(a, dt, legacy_lowpass_sections, 0.0)[0]
+
+
+def _mean_square(y, start):
+    from .ride_metrics_jit import sum_of_squares  # numba: loaded when first needed
+
+    return sum_of_squares(y, start) / (y.shape[0] - start)
+
+
+def _dose(y, start, dt):
+    """(sum of y^4 dt)^(1/4) over i >= start; the fourth root as two square roots (exact IEEE
+    operations)."""
+    from .ride_metrics_jit import sum_of_fourth_powers  # numba: loaded when first needed
+
+    return math.sqrt(math.sqrt(sum_of_fourth_powers(y, start) * dt))
+
+
+def ride_figures(a, dt, settle):
+    """Every ride metric of one seat acceleration at once (each filter run once): a dict of
+    peak_seat_acceleration_g (over the whole signal), peak_index (the sample of that peak),
+    absorbed_power, weighted_rms_acceleration and vdv (over the samples at t >= settle)."""
+    from .ride_metrics_jit import max_abs  # numba: loaded when first needed
+
+    low = legacy_lowpass(a, dt)
+    peak = max_abs(low, 0)
+    absorbed, start = _filtered(a, dt, absorbed_power_sections, settle)
+    weighted, _ = _filtered(a, dt, wk_sections, settle)
+    return {
+        "peak_seat_acceleration_g": peak / G,
+        "peak_index": int(np.flatnonzero(np.abs(low) == peak)[0]),
+        "absorbed_power": _mean_square(absorbed, start),
+        "weighted_rms_acceleration": math.sqrt(_mean_square(weighted, start)),
+        "vdv": _dose(weighted, start, dt),
+    }
+
+
 def absorbed_power(a, dt, settle):
     """Pradko and Lee's vertical absorbed power (W; the spec's limit: 6 W): the mean of the
     filter's output squared over the samples at t >= settle (s). The filter, H(s) = 14.5 s
     (s + 44) / ((s + 63)(s^2 + 24 s + 750)), takes a in ft/s^2 (a in m/s^2 times FT_PER_M,
     carried in its gain); plain bilinear (absorbed_power_sections). A sinusoid of 1 m/s^2
     gives 0.0417, 0.2053, 1.0558, 0.4259, 0.1048 W at 1, 2, 4, 8, 16 Hz."""
-    from .ride_metrics_jit import sum_of_squares  # numba: loaded when first needed
-
     y, start = _filtered(a, dt, absorbed_power_sections, settle)
-    return sum_of_squares(y, start) / (y.shape[0] - start)
+    return _mean_square(y, start)
 
 
 def weighted_rms_acceleration(a, dt, settle):
     """ISO 2631-1's weighted RMS acceleration (m/s^2): sqrt of the mean of a_w^2 over the
     samples at t >= settle (s), a_w = a after Wk (wk_sections)."""
-    from .ride_metrics_jit import sum_of_squares  # numba: loaded when first needed
-
     y, start = _filtered(a, dt, wk_sections, settle)
-    return math.sqrt(sum_of_squares(y, start) / (y.shape[0] - start))
+    return math.sqrt(_mean_square(y, start))
 
 
 def vdv(a, dt, settle):
     """Vibration dose value (m/s^1.75): (sum of a_w^4 dt)^(1/4) over the samples at t >=
-    settle (s), a_w = a after Wk (wk_sections); the fourth root as two square roots (exact
-    IEEE operations). For a_w = A sin(2 pi f t) over whole periods, T long: (3 T / 8)^(1/4) A."""
-    from .ride_metrics_jit import sum_of_fourth_powers  # numba: loaded when first needed
-
+    settle (s), a_w = a after Wk (wk_sections). For a_w = A sin(2 pi f t) over whole periods,
+    T long: (3 T / 8)^(1/4) A."""
     y, start = _filtered(a, dt, wk_sections, settle)
-    return math.sqrt(math.sqrt(sum_of_fourth_powers(y, start) * dt))
+    return _dose(y, start, dt)
 
 
 def seat_acceleration(ay, alpha, omega, seat_x, seat_y, pitch):

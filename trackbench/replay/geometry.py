@@ -180,9 +180,14 @@ def covered_x_range(ds):
     return float(lo), float(hi)
 
 
+def ground_vertices(ds):
+    """The ground polyline's vertices (n, 2), m: the terrain the run had, rough ground included."""
+    return np.column_stack([ds["ground_x"].values, ds["ground_y"].values])
+
+
 def ground_polyline(ds, x_range=None):
     """The ground vertices (m, 2) clipped to x_range (default: the covered range)."""
-    v = np.asarray(attr_json(ds, "ground_vertices"), dtype=float)
+    v = ground_vertices(ds)
     x0, x1 = covered_x_range(ds) if x_range is None else x_range
 
     def at(x):

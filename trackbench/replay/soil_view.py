@@ -3,7 +3,7 @@ so far."""
 
 import numpy as np
 
-from .geometry import attr_json, ground_polyline, scenario_of
+from .geometry import ground_polyline, ground_vertices, scenario_of
 
 
 def is_soil(ds):
@@ -97,7 +97,7 @@ def soil_surface(ds, idx, x_range=None):
     rut_v = np.where(inside, rut[:, j - 1] * (1.0 - w) + rut[:, j] * w, 0.0)
     # merge the cell points into the ground's vertices (stable: vertical faces keep their order)
     xs = np.concatenate([gx, cx])
-    v = np.asarray(attr_json(ds, "ground_vertices"), dtype=float)
+    v = ground_vertices(ds)
     seg = np.clip(np.searchsorted(v[:, 0], xs, side="right") - 1, 0, len(v) - 2)
     dxs, dys = v[seg + 1, 0] - v[seg, 0], v[seg + 1, 1] - v[seg, 1]
     flat = dxs > 0.0

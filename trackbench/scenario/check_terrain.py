@@ -9,6 +9,7 @@ from .parameters_table import (
     OBSTACLE_KEYS,
     OBSTACLE_KIND_RULE,
     PAPER_FIRST_CONTACT_TIME,
+    RANDOM_DEFAULTS,
     TERRAIN_KEYS,
     TERRAIN_OPEN_LOW,
     TERRAIN_RULES,
@@ -41,7 +42,51 @@ def _terrain_shape(t):
         return _points(t)
     if kind == "sequence":
         return _sequence(t)
+    if kind in ("random", "profile"):
+        return _rough(t, kind)
     return _validate_obstacle(t, "terrain", True)
+
+
+def _rough(t, kind):
+    """A random profile (its arguments checked, the profile made when the run starts) or a
+    measured one (its file read now, so that a missing or malformed file stops before any
+    work): model/ground/rough.py."""
+    from ..model.ground import rough
+
+    allowed = TERRAIN_KEYS[kind]
+    out = {"kind": kind, **(RANDOM_DEFAULTS if kind == "random" else {})}
+    for k, v in t.items():
+        if k == "kind":
+            continue
+        if k not in allowed:
+            raise ScenarioError(
+                f"terrain.{k} does not apply to kind '{kind}'; allowed: {', '.join(sorted(allowed))}"
+            )
+        out[k] = check_value(f"terrain.{k}", v, TERRAIN_RULES[k], open_low=k in TERRAIN_OPEN_LOW)
+    try:
+        if kind == "profile":
+            if "file" not in out:
+                raise ValueError("terrain.file is missing: a profile needs its CSV file of x, height (m)")
+            rough.read_profile_csv(out["file"])
+        elif out["wavelength_min"] < 4 * rough.SPACING:
+            raise ValueError(
+                f"terrain.wavelength_min = {out['wavelength_min']!r} m is not allowed: expected at least "
+                f"{4 * rough.SPACING:g} m (the profile is sampled every {rough.SPACING:g} m)"
+            )
+        else:
+            rough.check_random(out["length"], out["seed"], out.get("roughness_class"), out.get("rms"),
+                               out["wavelength_min"], out["wavelength_max"], rough.SPACING, out["run_in"],
+                               rough.BLEND)
+    except ValueError as e:
+        text = str(e)
+        if text.split(" ")[0] in allowed:
+            text = "terrain." + text
+        elif text.startswith("profile"):
+            text = "terrain.file: " + text
+        elif not text.startswith("terrain."):
+            text = "terrain: " + text
+        raise ScenarioError(text) from None
+    return out
 
 
 def _points(t):

@@ -5,13 +5,15 @@ import math
 
 from ..model.contact.laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
 from ..model.core.indices import DRIVES
+from ..model.ground.rough import CLASSES
 from ..model.vehicle.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle
 from ..presets import PRESETS
 from ..solvers.registry import METHODS
 from ..solvers.registry import SOLVERS as _REGISTRY
 
+ROUGHNESS_CLASSES = tuple(CLASSES)
 SOLVERS = tuple(_REGISTRY)  # the time integrators by name: solvers/registry.py
-TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence")
+TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence", "random", "profile")
 OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
 PLACEMENT_KEYS = ("position", "first_contact_time", "gap")  # where an obstacle stands: one of them
 PAPER_FIRST_CONTACT_TIME = 0.0568  # s: also the default of a first obstacle given no placement
@@ -80,6 +82,8 @@ RULES = {
     "vehicle.pivot_spacing": _POS,
     "vehicle.front_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
     "vehicle.rear_track_end": (list, None, None, "a pair [x, y] of finite numbers (m)"),
+    "vehicle.seat_x": (float, -100.0, 100.0, "a number in [-100, 100] m (forward of the mass centre)"),
+    "vehicle.seat_y": (float, -100.0, 100.0, "a number in [-100, 100] m (above the mass centre)"),
     "track.n_links": (int, 4, 400, "an integer in [4, 400]"),
     "track.link_length": _POS,
     "track.pin_mass": _POS,
@@ -172,6 +176,8 @@ UNITS = {
     "vehicle.pivot_spacing": "m",
     "vehicle.front_track_end": "m",
     "vehicle.rear_track_end": "m",
+    "vehicle.seat_x": "m",
+    "vehicle.seat_y": "m",
     "track.link_length": "m",
     "track.pin_mass": "kg",
     "track.link_stiffness": "N/m",
@@ -218,6 +224,10 @@ UNITS = {
     "terrain.position": "m",
     "terrain.first_contact_time": "s",
     "terrain.gap": "m",
+    "terrain.rms": "m",
+    "terrain.wavelength_min": "m",
+    "terrain.wavelength_max": "m",
+    "terrain.run_in": "m",
 }
 
 # the names whose low bound is itself not allowed
@@ -247,8 +257,15 @@ TERRAIN_RULES = {
     "points": (list, None, None, "a list of [x, y] pairs with x non-decreasing"),
     "obstacles": (list, None, None, "a list of obstacle tables"),
     "soil": (str, None, None, "rigid, a soil name (trackbench params) or a table of soil values"),
+    "roughness_class": (str, ROUGHNESS_CLASSES, None, "one of " + ", ".join(ROUGHNESS_CLASSES)),
+    "rms": (float, 0.0, 1.0, "a number in (0, 1] m (the profile's RMS elevation over its band)"),
+    "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
+    "wavelength_min": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
+    "wavelength_max": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
+    "run_in": (float, 0.0, 1000.0, "a number in [0, 1000] m (flat ground before the rough section)"),
+    "file": (str, None, None, "a CSV file of x, height (m)"),
 }
-TERRAIN_OPEN_LOW = ("height", "length", "first_contact_time")
+TERRAIN_OPEN_LOW = ("height", "length", "first_contact_time", "rms", "wavelength_min", "wavelength_max")
 OBSTACLE_KIND_RULE = (str, OBSTACLE_KINDS, None, "one of " + ", ".join(OBSTACLE_KINDS))
 # the keys each kind takes: as the whole terrain, and as one obstacle of a sequence
 TERRAIN_KEYS = {
@@ -259,7 +276,13 @@ TERRAIN_KEYS = {
     "bump": {"height", "length", "position"},
     "points": {"points"},
     "sequence": {"obstacles"},
+    "random": {"roughness_class", "rms", "length", "seed", "wavelength_min", "wavelength_max", "run_in"},
+    "profile": {"file"},
 }
+# a random profile's defaults (model/ground/rough.py): 100 m of rough ground after 10 m of flat
+# run-in (the vehicle starts at rest on flat ground), wavelengths 0.5-20 m (below 0.5 m the
+# track's pitch and pads bridge the ground; 20 m is 10 s of pitch at 2 m/s)
+RANDOM_DEFAULTS = {"length": 100.0, "seed": 0, "wavelength_min": 0.5, "wavelength_max": 20.0, "run_in": 10.0}
 OBSTACLE_KEYS = {
     "step": {"height", "position", "gap", "first_contact_time"},
     "ramp": {"height", "length", "position", "gap"},

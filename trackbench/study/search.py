@@ -256,6 +256,21 @@ def parse_search(where, table, varied):
     return SearchSpec(parameter=name, quantity=table["quantity"], **nums)
 
 
+def check_held_speed(where, spec, scenarios):
+    """A search of the speed needs every run to hold its speed: the closed track's speed drive.
+    The paper's bolted track coasts (on friction it brakes like a sled), another drive lets the
+    speed go where the torque takes it: a limit speed found on them would be no speed at all."""
+    from .spec import StudyError
+    if spec.parameter != "speed":
+        return
+    for sc in scenarios:
+        layout, drive = sc["track"]["layout"], sc["drive"]["kind"]
+        if layout != "closed" or drive != "speed":
+            what = "the paper's bolted track coasts" if layout != "closed" else f"drive.kind = {drive!r}"
+            raise StudyError(f"{where}: [search] parameter = speed needs the speed held, but {what}; "
+                             'allowed: track.layout = "closed" with drive.kind = "speed"')
+
+
 def _number(where, key, v):
     from .spec import StudyError, _is_number
     if not _is_number(v) or not math.isfinite(v):

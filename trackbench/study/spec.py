@@ -282,6 +282,7 @@ def load_study(path, output=None):
     base_doc = doc.get("scenario", {})
     if not isinstance(base_doc, dict):
         raise StudyError(f"{path}: [scenario] must be a table")
+    base_doc = _files_beside(base_doc, path)
     try:
         base = Scenario.from_dict(base_doc)
     except ScenarioError as e:
@@ -315,10 +316,25 @@ def load_study(path, output=None):
             study.runs.append(run)
     if study.search is not None:
         from .. import quantities as Q
-        from .search import check_quantity
+        from .search import check_held_speed, check_quantity
         wheels, features = Q.shape_of(r.scenario for r in study.runs)
         check_quantity(str(path), study.search, Q.summary_columns(wheels, features=features))
+        check_held_speed(str(path), study.search, [r.scenario for r in study.runs])
     return study
+
+
+def _files_beside(base_doc, path):
+    """The base scenario with a measured profile's file (terrain.file) taken against the study
+    file's folder when it is relative, as a reader of the study file would take it."""
+    def beside(file):
+        return str(path.parent / file) if isinstance(file, str) and not Path(file).is_absolute() else file
+
+    terrain = base_doc.get("terrain")
+    if isinstance(terrain, dict) and "file" in terrain:
+        base_doc = {**base_doc, "terrain": {**terrain, "file": beside(terrain["file"])}}
+    if "terrain.file" in base_doc:   # the dotted form
+        base_doc = {**base_doc, "terrain.file": beside(base_doc["terrain.file"])}
+    return base_doc
 
 
 def _make_run(study, vi, over, r, path):

@@ -5,6 +5,8 @@ moved more than the skin."""
 from numba import njit
 
 from ..core.indices import (
+    C_CORNER_END,
+    C_CORNER_FIRST,
     C_REBUILDS,
     G_REACH,
     K_CORNER_LINK,
@@ -65,6 +67,37 @@ def _near_pins(px, py, apos, last, reach, nbr, row):
     nbr[row, NB_COUNT] = n
 
 
+@njit(**INLINE)
+def _first_corner_beyond(corners, x, inclusive):
+    """The first corner at x or beyond (inclusive) or beyond x alone; the corners' x ascend
+    as the ground's vertices do."""
+    lo, hi = 0, corners.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if corners[mid, 0] < x or (not inclusive and corners[mid, 0] == x):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@njit(**INLINE)
+def _corner_window(apos, m, reach):
+    """Clear the corner rows of the last window, then the new window: the corners within
+    reach in x of the pins (links lie between them), the only ones with candidates."""
+    nbr, rows, counters = m.nbr, m.nbr_rows, m.counters
+    for c in range(counters[C_CORNER_FIRST], counters[C_CORNER_END]):
+        nbr[rows[K_CORNER_LINK] + c, NB_COUNT] = 0
+        nbr[rows[K_CORNER_PIN] + c, NB_COUNT] = 0
+    lo, hi = apos[0, 0], apos[0, 0]
+    for b in range(apos.shape[0]):
+        lo = min(lo, apos[b, 0])
+        hi = max(hi, apos[b, 0])
+    counters[C_CORNER_FIRST] = _first_corner_beyond(m.corners, lo - reach, True)
+    counters[C_CORNER_END] = _first_corner_beyond(m.corners, hi + reach, False)
+    return counters[C_CORNER_FIRST], counters[C_CORNER_END]
+
+
 @njit(**BORROW)
 def build_neighbours(apos, wc, gc, m):
     """Fill the candidate lists: every pair that could touch while no pin, wheel, idler or
@@ -82,7 +115,7 @@ def build_neighbours(apos, wc, gc, m):
         reach_g = m.guides[j, G_REACH] + skin
         _near_links(gc[j, 0], gc[j, 1], apos, reach_g, nbr, rows[K_GUIDE_LINK] + j)
         _near_pins(gc[j, 0], gc[j, 1], apos, last, reach_g, nbr, rows[K_GUIDE_PIN] + j)
-    for c in range(corners.shape[0]):
+    for c in range(*_corner_window(apos, m, max(reach_cl, hg + skin))):
         _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
         _near_pins(corners[c, 0], corners[c, 1], apos, last, hg + skin, nbr, rows[K_CORNER_PIN] + c)
     for b in range(1, last + 1):

@@ -246,7 +246,9 @@ N_SP = 9
 # --- run counters of the model arrays, ``counters`` -----------------------------------
 C_REBUILDS = 0           # candidate-list rebuilds
 C_EVALUATIONS = 1        # evaluations of the track forces (stamps the pairs seen in contact)
-N_COUNTERS = 2
+C_CORNER_FIRST = 2       # the ground corners within reach of the track at the last rebuild:
+C_CORNER_END = 3         # first, one past the last (a rough ground has thousands; a few matter)
+N_COUNTERS = 4
 
 # --- scalar parameters, ``par`` ---------------------------------------------------
 P_CHASSIS_MASS = 0
@@ -333,7 +335,8 @@ D_DRIVE_TORQUE = 17      # torque of the drive on the sprocket, forward positive
 D_IDLER_FORCE = 18       # tensioner force along the guide, outward positive (N)
 D_TEETH_TORQUE = 19      # torque of the pins on the sprocket, forward positive (N m)
 D_DRAWBAR = 20           # force of the drawbar on the chassis, rearward positive (N; closed layout)
-D_WHEEL = 21             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
+D_CHASSIS_ALPHA = 21     # chassis pitch acceleration (rad/s^2; the seat's acceleration needs it)
+D_WHEEL = 22             # wheel-track contact force on wheel i: diag[D_WHEEL + 2 i + k]
 
 
 def diag_tension(n_wheels):

@@ -31,6 +31,7 @@ from ..core.indices import (
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
     D_E_GRAVITY,
@@ -352,3 +353,4 @@ def finish_diag(z, zd, zdd, par, arms, power, diag):
     diag[D_POWER] = power
     diag[D_CHASSIS_AX] = zdd[Z_X]
     diag[D_CHASSIS_AY] = zdd[Z_Y]
+    diag[D_CHASSIS_ALPHA] = zdd[Z_PITCH]

@@ -386,7 +386,7 @@ def closed_rhs(y, m, w, ydot, diag):
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
     ydot[2 * nq + Y_DRIVE_WORK] = drive_power
     ydot[2 * nq + Y_DRIVE_INTEGRAL] = d_integral
-    store_state_energies(diag, (ke, e_tors, e_grav), acc3[0], acc3[1])
+    store_state_energies(diag, (ke, e_tors, e_grav), acc3)
     diag[D_DRIVE_TORQUE] = tau
     diag[D_IDLER_FORCE] = tension_force
     diag[D_DRAWBAR] = drawbar

@@ -18,6 +18,7 @@ from ..core.indices import (
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
     D_DISSIPATION,
@@ -199,11 +200,10 @@ def row_acceleration(rows, i, d, acc3):
 
 
 @njit(**INLINE)
-def store_state_energies(diag, energies, ax, ay):
-    """Kinetic, torsion and gravity energy and the chassis acceleration into diag."""
+def store_state_energies(diag, energies, acc3):
+    """Kinetic, torsion and gravity energy and the chassis acceleration (ax, ay, alpha) into diag."""
     diag[D_E_KINETIC], diag[D_E_TORSION], diag[D_E_GRAVITY] = energies
-    diag[D_CHASSIS_AX] = ax
-    diag[D_CHASSIS_AY] = ay
+    diag[D_CHASSIS_AX], diag[D_CHASSIS_AY], diag[D_CHASSIS_ALPHA] = acc3
 
 
 @njit(**BORROW)
@@ -233,4 +233,4 @@ def reduced_rhs(y, m, w, ydot, diag):
     diag[D_DISSIPATION] += arm_dissipation
     ydot[2 * nq + Y_WORK] = diag[D_POWER] - arm_dissipation  # dW/dt: contact forces and dampers
     ydot[2 * nq + Y_DISSIPATED] = diag[D_DISSIPATION]
-    store_state_energies(diag, (ke, e_tors, e_grav), acc3[0], acc3[1])
+    store_state_energies(diag, (ke, e_tors, e_grav), acc3)

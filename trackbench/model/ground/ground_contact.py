@@ -9,6 +9,8 @@ from ..contact.gaps import ground_distance, pin_ground_selection, pin_segment_va
 from ..contact.laws import DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
 from ..contact.track_contacts import _pad, _probe_on_track, _push_pin, contact_law
 from ..core.indices import (
+    C_CORNER_END,
+    C_CORNER_FIRST,
     D_CORNER_FORCE,
     D_DISSIPATION,
     D_E_PAD_GROUND,
@@ -151,7 +153,7 @@ def _corners(w, m, diag, mem, acc):
         par[P_FRICTION],
         par[P_FRICTION_VELOCITY],
     )
-    for c in range(m.corners.shape[0]):
+    for c in range(m.counters[C_CORNER_FIRST], m.counters[C_CORNER_END]):  # those within reach
         probe = (m.corners[c, 0], m.corners[c, 1], 0.0, 0.0)
         rows = (m.nbr_rows[K_CORNER_LINK] + c, m.nbr_rows[K_CORNER_PIN] + c)
         acc = _probe_on_track(probe, rule, rows, w, m.nbr, law, continuous, mem, diag, acc)

@@ -32,6 +32,9 @@ from pathlib import Path
 import numpy as np
 
 N0 = 0.1   # cycle/m, ISO 8608's reference wavenumber
+SPACING = 0.05   # m: a run's random profile sampled at most this far apart (a tenth of the
+#                  shortest default wavelength; the links are 0.19 m)
+BLEND = 5.0      # m: a run's random profile fades in over this much of its rough section
 CLASSES = {      # Gd(n0), m^3: the classes' geometric means
     "A": 16e-6, "B": 64e-6, "C": 256e-6, "D": 1024e-6,
     "E": 4096e-6, "F": 16384e-6, "G": 65536e-6, "H": 262144e-6,
@@ -164,6 +167,22 @@ def _fade_in(x, blend):
     return 0.5 - 0.5 * np.asarray(fm.vcos(math.pi * u))
 
 
+def check_random(length, seed, roughness_class, rms, wavelength_min, wavelength_max, dx, run_in, blend):
+    """random_profile's arguments checked (a one-line ValueError naming the culprit), without
+    making the profile: (Gd(n0) or None, rms, seed, (length, wavelength_min, wavelength_max, dx),
+    run_in, blend)."""
+    psd0 = _class_psd(roughness_class, rms)
+    if rms is not None:
+        rms = _number("rms", rms, 0.0, "a number > 0 (m)")
+    seed = _seed(seed)
+    band = _check_band(length, wavelength_min, wavelength_max, dx)
+    run_in = _number("run_in", run_in, 0.0, "a number >= 0 (m)", strict=False)
+    blend = _number("blend", blend, 0.0, "a number >= 0 (m)", strict=False)
+    if blend > band[0]:
+        raise ValueError(f"blend = {blend!r} m is not allowed: expected at most length = {band[0]!r} m")
+    return psd0, rms, seed, band, run_in, blend
+
+
 def random_profile(
     length,
     seed,
@@ -185,16 +204,9 @@ def random_profile(
     wavelength_min < wavelength_max <= length (m): the band generated; dx <=
     wavelength_min / 4; run_in >= 0; 0 <= blend <= length. The same arguments give the
     same profile bit for bit; another seed another profile."""
-    psd0 = _class_psd(roughness_class, rms)
-    if rms is not None:
-        rms = _number("rms", rms, 0.0, "a number > 0 (m)")
-    seed = _seed(seed)
-    length, lo, hi, dx = _check_band(length, wavelength_min, wavelength_max, dx)
-    run_in = _number("run_in", run_in, 0.0, "a number >= 0 (m)", strict=False)
-    blend = _number("blend", blend, 0.0, "a number >= 0 (m)", strict=False)
-    if blend > length:
-        raise ValueError(f"blend = {blend!r} m is not allowed: expected at most length = {length!r} m")
-
+    psd0, rms, seed, (length, lo, hi, dx), run_in, blend = check_random(
+        length, seed, roughness_class, rms, wavelength_min, wavelength_max, dx, run_in, blend
+    )
     k = _wavenumber_indices(length, lo, hi)
     phase = (2.0 * math.pi) * np.random.Generator(np.random.PCG64(seed)).random(k.shape[0])
     m = 2

@@ -117,6 +117,39 @@ def _check_ahead(x, ob, eq, pad_ground):
         )
 
 
+STANDING_FLATNESS = 1e-6  # m: how flat a rough ground must be where the vehicle stands at the start
+
+
+def rough_points(t):
+    """(x, height) of a random or measured profile (model/ground/rough.py), x as given."""
+    from . import rough
+
+    if t["kind"] == "profile":
+        return rough.read_profile_csv(t["file"])
+    return rough.random_profile(
+        t["length"], t["seed"], t.get("roughness_class"), t.get("rms"), wavelength_min=t["wavelength_min"],
+        wavelength_max=t["wavelength_max"], dx=rough.SPACING, run_in=t["run_in"], blend=rough.BLEND,
+    )
+
+
+def _standing(x, h, eq, pad_ground):
+    """The profile's heights relative to the ground under the resting track (which the
+    equilibrium puts at y = 0), once it is flat there: from the track's rearmost to its
+    foremost pin, pad included (the profile's first and last heights run on beyond its ends)."""
+    pins = eq.info["pins"]
+    lo, hi = float(pins[:, 0].min()) - pad_ground, float(pins[:, 0].max()) + pad_ground
+    inside = (x > lo) & (x < hi)
+    under = np.concatenate([np.interp([lo, hi], x, h), h[inside]])
+    spread = float(under.max() - under.min())
+    if spread > STANDING_FLATNESS:
+        raise ValueError(
+            f"terrain: the vehicle cannot stand on the ground at the start: it is not flat under the "
+            f"resting track (x = {lo:.3g} .. {hi:.3g} m, heights vary by {spread:.3g} m); allowed: flat "
+            f"within {STANDING_FLATNESS:g} m there (a flat run-in)"
+        )
+    return h - under[0]
+
+
 def build_ground(scenario, eq):
     """Terrain polyline of the scenario, with obstacles placed by time resolved."""
     t = scenario["terrain"]
@@ -124,6 +157,10 @@ def build_ground(scenario, eq):
         return ground_from_points([[-FAR, 0.0], [FAR, 0.0]]), {}
     if t["kind"] == "points":
         return ground_from_points(t["points"], merge_straight=True), {}
+    if t["kind"] in ("random", "profile"):
+        x, h = rough_points(t)
+        h = _standing(x, h, eq, scenario["track.pad_ground"])
+        return ground_from_points(np.column_stack([x, h]), merge_straight=True), {}
     obstacles = t["obstacles"] if t["kind"] == "sequence" else [t]
     pts = [[-FAR, 0.0]]
     level = 0.0

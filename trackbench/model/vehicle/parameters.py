@@ -39,6 +39,11 @@ def paper_vehicle():
         "front_track_end": [2.54, 0.0],   # body point where pin 0 is fixed (m)
         "rear_track_end": [-2.81, 0.0],   # body point where the last pin is fixed (m)
         "arm_damping": [],                # rotary shock absorber per station (N m s/rad); [] = none
+        # the driver's seat (no part of the paper's model: the ride metrics are read there), a
+        # body point from the mass centre: in the front third of the hull (track ends at 2.54
+        # and -2.81 m), between road wheels 1 and 2, 0.3 m above the mass centre
+        "seat_x": 1.5,
+        "seat_y": 0.3,
     }
 
 
