@@ -237,7 +237,7 @@ def test_interrupted_search_keeps_its_runs_and_says_how_far_it_is(searched):
     n = len(stopped["done"])   # 7, and those in flight then (the pool finishes them)
     assert waves == [10] and 7 <= n < 10
     lim = stopped["limits"]
-    assert list(lim.columns) == ["terrain.height", "search_value", "status", "runs"]
+    assert list(lim.columns) == ["terrain.height", "search_value", "status", "runs", "limit_run"]
     assert set(lim.status) == {"pending"} and lim.search_value.isna().all()
     st = stopped["status"]
     assert st.returncode == 0, st.stderr
@@ -292,6 +292,18 @@ def test_search_status_summary_and_a_second_resume(searched):
     o = run_study(d / "lim.toml", workers=2, quiet=True)
     assert (o.ran, o.skipped) == (0, 16) and files(out / "runs") == snap
     assert o.limits.status.tolist() == ["found", "found"]
+
+
+def test_plot_draws_the_limit_curve_and_names_the_run_at_the_limit(searched, tmp_path):
+    from trackbench.replay.plots import plot_study
+    d, out = searched[0], searched[1]
+    lim = pd.read_csv(out / "limits.csv")
+    summary = pd.read_csv(out / "summary.csv").set_index("run_id")
+    for run, v in zip(lim.limit_run, lim.search_value):   # the run at the limit, to replay
+        assert summary.loc[run, "speed"] == v and (out / "runs" / run / "timeseries.nc").exists()
+    paths = [p.name for p in plot_study(out, tmp_path)]
+    assert {"limit_speed.png", "search_peak_wheel1_force_y.png"} <= set(paths)
+    assert all((tmp_path / p).stat().st_size > 10_000 for p in paths)
 
 
 def test_search_on_dask_gives_the_same_limits(searched, tmp_path):

@@ -333,7 +333,8 @@ def plot_study(study_dir, out_dir):
         plt.close(fig)
         paths.append(path)
     drawbar = _plot_drawbar_pull(src, df[completed], out, has_drawbar=_has_drawbar(df, axes))
-    return paths + ([drawbar] if drawbar else [])
+    from .limit_figures import plot_limits
+    return paths + ([drawbar] if drawbar else []) + plot_limits(src, df, out, plt)
 
 
 def remove_stale(out_dir, written):

@@ -2,7 +2,8 @@
 a grid with that value gives), run in waves on the study's executor; limits.csv, open_limits
 and the search's state read back from the results folder.
 
-    <output>/limits.csv   one row per grid point: its parameters, search_value, status, runs
+    <output>/limits.csv   one row per grid point: its parameters, search_value, status, runs,
+                          limit_run (the run id at search_value, to replay)
 """
 
 from pathlib import Path
@@ -11,7 +12,7 @@ from . import search as S
 from . import store
 from .spec import StudyError, search_run
 
-LIMIT_COLUMNS = ["search_value", "status", "runs"]
+LIMIT_COLUMNS = ["search_value", "status", "runs", "limit_run"]
 LIMITS_FILE = "limits.csv"
 
 
@@ -64,7 +65,7 @@ def search_state(study):
 
 
 def limits_frame(study, searches):
-    """One row per grid point: the grid's parameters, search_value, status, runs."""
+    """One row per grid point: the grid's parameters, search_value, status, runs, limit_run."""
     import pandas as pd
 
     from .spec import _param_value
@@ -73,7 +74,9 @@ def limits_frame(study, searches):
     for ps in searches:
         row = {n: _param_value(study.points[ps.point][n]) if n in study.points[ps.point] else None
                for n in names}
-        row.update(search_value=ps.search_value, status=ps.status, runs=ps.runs)
+        at = search_run(study, ps.point, ps.search_value) if ps.search_value is not None else None
+        row.update(search_value=ps.search_value, status=ps.status, runs=ps.runs,
+                   limit_run=at.run_id if at is not None else None)
         rows.append(row)
     df = pd.DataFrame(rows, columns=names + LIMIT_COLUMNS)
     df["search_value"] = df["search_value"].astype(float)
