@@ -100,14 +100,18 @@ def test_non_monotone_is_said_and_its_first_crossing_bisected():
 
 
 def test_failed_and_pending_runs_end_a_point_and_the_waves_go_on_without_it():
-    sp = spec()
-    q = {"ok": lambda x: x / 10.0, "fails": lambda x: None if x > 12.0 else x / 10.0,
-         "nan": lambda x: math.nan, "pending": lambda x: S.PENDING if x == 2.0 else 0.0}
+    sp = spec()   # scan 2, 6.5, 11, 15.5, 20; q = x / 10 crosses the limit at 10
+    q = {"ok": lambda x: x / 10.0, "fails": lambda x: None if 5.0 < x < 12.0 else x / 10.0,
+         "nan": lambda x: math.nan, "pending": lambda x: S.PENDING if x == 2.0 else 0.0,
+         "fails_beyond": lambda x: None if x > 12.0 else x / 10.0}
     ev = Counted(lambda p, x: q[p](x))
-    ok, fails, nan, pending = S.search_limits(sp, list(q), ev)
+    ok, fails, nan, pending, beyond = S.search_limits(sp, list(q), ev)
     assert ok.status == "found" and fails.status == "failed" and nan.status == "failed"
     assert pending.status == "pending" and pending.runs == 4 and pending.search_value is None
-    assert fails.search_value is None and ev.calls == [20] + [1] * S.bisection_rounds(sp)
+    assert fails.search_value is None
+    # failed above the crossing: the limit is found below it, as for ok
+    assert beyond.status == "found" and beyond.search_value == ok.search_value
+    assert ev.calls == [25] + [2] * S.bisection_rounds(sp)
 
 
 def test_scan_values_are_a_grid_range_and_lines_say_how_far():

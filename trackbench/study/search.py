@@ -23,8 +23,11 @@ The algorithm, for every grid point at once (search_limits):
 
 Evaluations per grid point: SCAN_POINTS for the scan, plus bisection_rounds() when the scan
 brackets a crossing (at most 1 + bisection_rounds() waves of runs in all). A run that fails, or
-gives no number for the quantity, ends its point's search as failed (no value); a value the
-callback cannot give yet (PENDING) leaves the point pending.
+gives no number for the quantity, ends its point's search as failed (no value), unless the
+scan crossed the limit below it: the limit is decided below the first such run (a run over an
+obstacle too fast for the model to finish lies beyond the limit it is searched for, as it
+does in the shipped obstacle study). A value the callback cannot give yet (PENDING) leaves the
+point pending.
 """
 
 import difflib
@@ -118,9 +121,12 @@ def _decide_scan(spec, ps, xs, qs):
     if any(q is PENDING for q in qs):
         ps.status = PENDING_STATUS
         return
-    if any(q is None for q in qs):
-        ps.status = FAILED
-        return
+    if None in qs:
+        first_failed = qs.index(None)
+        if all(_within(spec, q) for q in qs[:first_failed]):   # no crossing below it: unknown
+            ps.status = FAILED
+            return
+        xs, qs = xs[:first_failed], qs[:first_failed]
     ok = [_within(spec, q) for q in qs]
     if not ok[0]:
         ps.status = EXCEEDED_AT_LOW

@@ -21,6 +21,8 @@ SCREEN = (
     "min_chassis_ay",
     "peak_chassis_ay",
     "min_chassis_vx",
+    "peak_seat_acceleration_g",
+    "absorbed_power",
     "first_compression_time",
     "peak_sprocket_torque",
     "peak_idler_force",
