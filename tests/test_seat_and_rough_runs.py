@@ -100,7 +100,8 @@ def test_the_recording_draws_the_rough_ground(rough_run):
     assert len(v) >= inside.sum() > 50
     # every vertex inside, and the ends cut where the range ends (interpolated: to rounding)
     assert set(rough_run.ground_x.values[inside]) <= set(v[:, 0])
-    np.testing.assert_allclose(np.interp(v[:, 0], rough_run.ground_x, rough_run.ground_y), v[:, 1], atol=1e-15)
+    on_ground = np.interp(v[:, 0], rough_run.ground_x, rough_run.ground_y)
+    np.testing.assert_allclose(on_ground, v[:, 1], atol=1e-15)
 
 
 def test_ground_the_vehicle_cannot_stand_on_is_refused_in_one_line(tmp_path):

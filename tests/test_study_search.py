@@ -300,7 +300,7 @@ def test_search_status_summary_and_a_second_resume(searched):
 
 def test_plot_draws_the_limit_curve_and_names_the_run_at_the_limit(searched, tmp_path):
     from trackbench.replay.plots import plot_study
-    d, out = searched[0], searched[1]
+    out = searched[1]
     lim = pd.read_csv(out / "limits.csv")
     summary = pd.read_csv(out / "summary.csv").set_index("run_id")
     for run, v in zip(lim.limit_run, lim.search_value):   # the run at the limit, to replay

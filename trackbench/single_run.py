@@ -97,6 +97,7 @@ def format_summary(ds, path=None):
             f"{shown('min_chassis_ay'):+.2f} .. {shown(ay.name):+.2f} {ay.unit}",
         ),
         line(vx.label, f"{shown(vx.name):.4f} {vx.unit}"),
+        _seat_line(ds, shown, line),
         line(
             contact.label,
             f"{_time(shown(contact.name), 5)}{_unmet(ds, shown(contact.name))}; "
@@ -120,6 +121,17 @@ def format_summary(ds, path=None):
     for p in ([path] if isinstance(path, (str, Path)) else path or []):
         lines.append(f"  written: {p}")
     return "\n".join(lines)
+
+
+def _seat_line(ds, shown, line):
+    """The driver's seat: its peak through the 30 Hz low-pass and the ride figures of the run's
+    second half (NaN where the samples are too far apart for the weightings)."""
+    peak = shown("peak_seat_acceleration_g")
+    if peak != peak:
+        return line("driver's seat", "- (ride metrics need output_interval <= 1/250 s)")
+    return line("driver's seat", f"{peak:.3f} g at {float(ds.peak_seat_acceleration_g_time):.4f} s (30 Hz); "
+                f"2nd half: {shown('absorbed_power'):.3g} W absorbed, Wk RMS "
+                f"{shown('weighted_rms_acceleration'):.3g} m/s^2, VDV {shown('vdv'):.3g} m/s^1.75")
 
 
 DEFAULT_NAME = "paper_step"
