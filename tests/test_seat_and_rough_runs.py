@@ -140,3 +140,38 @@ def test_a_study_reads_its_profile_beside_the_study_file(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)          # elsewhere: the path is the study file's, not the shell's
     s = load_study(study)
     assert s.runs[0].scenario["terrain"]["file"] == str(tmp_path / "courses" / "course.csv")
+
+
+def test_a_long_course_holds_candidate_rows_by_its_length_not_its_square():
+    """600 m of rough ground (16,385 segments): the candidate rows hold SEGMENT_CANDIDATES
+    segments each (before, as many as the ground has: 2 GB an array), and the run goes."""
+    from trackbench.assembly import Model, equilibrium
+    from trackbench.model.core.indices import SEGMENT_CANDIDATES
+    from trackbench.simulate import build_ground
+
+    sc = tb.Scenario.paper(duration=0.05, terrain={**ROUGH, "length": 600.0})
+    eq = equilibrium(sc)
+    ground, _ = build_ground(sc, eq)
+    arrays = Model(sc, eq, ground).arrays
+    assert ground.segments.shape[0] > 16_000 and arrays.nbr.shape[1] == 1 + SEGMENT_CANDIDATES
+    assert arrays.nbr.nbytes + arrays.v0.nbytes < 100e6
+    assert tb.simulate(sc).attrs["status"] == "completed"
+
+
+def test_a_ground_too_dense_for_the_candidate_rows_stops_the_run_saying_so(tmp_path):
+    """1,000 segments of 0.2 mm under the track (wiggles of 1e-7 m: flat enough to stand on,
+    no straight run to merge): more than a row holds near one pin."""
+    x = np.concatenate([[-50.0], np.linspace(0.0, 0.2, 1001), [50.0]])
+    h = np.concatenate([[0.0], 1e-7 * (np.arange(1001) % 2), [0.0]])
+    p = tmp_path / "dense.csv"
+    p.write_text("x,height\n" + "\n".join(f"{a!r},{b!r}" for a, b in zip(x.tolist(), h.tolist())))
+    ds = tb.simulate(tb.Scenario.paper(duration=0.01, terrain={"kind": "profile", "file": str(p)}))
+    assert ds.attrs["status"] == "failed" and "too dense" in ds.attrs["status_message"]
+
+
+def test_restitution_laws_on_a_long_ground_are_refused_in_one_line():
+    with pytest.raises(ScenarioError) as e:
+        tb.simulate(tb.Scenario.paper(terrain=ROUGH, **{"contact.damping": "hunt_crossley",
+                                                        "contact.restitution": 0.75}))
+    assert "contact.damping = 'hunt_crossley' cannot run on this ground" in str(e.value)
+    assert "\n" not in str(e.value)

@@ -17,6 +17,7 @@ class Result(IntEnum):
     CONSTRAINT_ITERATION = 6
     PIN_THROUGH_SPROCKET = 7
     IDLER_OFF_GUIDE = 8
+    GROUND_CANDIDATES = 9
 
     @property
     def message(self) -> str:
@@ -41,6 +42,8 @@ _MESSAGES = {
     Result.CONSTRAINT_ITERATION: "the Lagrange-multiplier iteration did not converge",
     Result.PIN_THROUGH_SPROCKET: "a track pin went into a sprocket tooth (it jumped the teeth)",
     Result.IDLER_OFF_GUIDE: "the idler ran off the end of its guide (idler.travel)",
+    Result.GROUND_CANDIDATES: "more ground segments lie near one pin than the contact search holds "
+    "(256 on a ground of more segments): the ground's polyline is too dense there; sample it coarser",
 }
 
 # plain ints for use inside numba kernels
@@ -53,3 +56,4 @@ MAX_STEPS = int(Result.MAX_STEPS)
 CONSTRAINT_ITERATION = int(Result.CONSTRAINT_ITERATION)
 PIN_THROUGH_SPROCKET = int(Result.PIN_THROUGH_SPROCKET)
 IDLER_OFF_GUIDE = int(Result.IDLER_OFF_GUIDE)
+GROUND_CANDIDATES = int(Result.GROUND_CANDIDATES)

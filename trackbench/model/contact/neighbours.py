@@ -7,8 +7,10 @@ from numba import njit
 from ..core.indices import (
     C_CORNER_END,
     C_CORNER_FIRST,
+    C_OVERFLOW,
     C_REBUILDS,
     G_REACH,
+    GROUND_WINDOW,
     K_CORNER_LINK,
     K_CORNER_PIN,
     K_GUIDE_LINK,
@@ -23,6 +25,9 @@ from ..core.indices import (
     P_WHEEL_RADIUS,
     PN_LAST,
     SEG_LENGTH,
+    SEG_TX,
+    SEG_X0,
+    SEGMENT_CANDIDATES,
 )
 from ..core.jit import BORROW, INLINE
 from .gaps import segment_coords
@@ -98,6 +103,57 @@ def _corner_window(apos, m, reach):
     return counters[C_CORNER_FIRST], counters[C_CORNER_END]
 
 
+@njit(**INLINE)
+def _segment_window(apos, seg, reach):
+    """(first, end) of the ground segments a pin may have as candidates: every one on a ground
+    of at most SEGMENT_CANDIDATES segments (the paper's and every obstacle's: a full search),
+    else those within GROUND_WINDOW + reach of the track in x (segments sorted by x, found by
+    bisection): a rough ground's gentle slopes keep the others out of a pin's reach."""
+    n = seg.shape[0]
+    if n <= SEGMENT_CANDIDATES:
+        return 0, n
+    lo, hi = apos[0, 0], apos[0, 0]
+    for b in range(apos.shape[0]):
+        lo = min(lo, apos[b, 0])
+        hi = max(hi, apos[b, 0])
+    margin = GROUND_WINDOW + reach
+    a, z = 0, n
+    while a < z:        # the first segment ending at or beyond lo - margin
+        mid = (a + z) // 2
+        if seg[mid, SEG_X0] + seg[mid, SEG_TX] * seg[mid, SEG_LENGTH] < lo - margin:
+            a = mid + 1
+        else:
+            z = mid
+    first = a
+    z = n
+    while a < z:        # the first segment starting beyond hi + margin
+        mid = (a + z) // 2
+        if seg[mid, SEG_X0] <= hi + margin:
+            a = mid + 1
+        else:
+            z = mid
+    return first, a
+
+
+@njit(**INLINE)
+def _pin_ground_row(apos, b, seg, window, skin, hg, m):
+    """Candidate row of free pin b: the segments of the window it could touch; flags an
+    overflow of the row (counters[C_OVERFLOW]) instead of writing beyond it."""
+    nbr = m.nbr
+    row = m.nbr_rows[K_PIN_GROUND] + b
+    room = nbr.shape[1] - 1
+    n = 0
+    for j in range(window[0], window[1]):
+        lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, j)
+        if lam > -skin and lam < seg[j, SEG_LENGTH] + skin and s < hg + skin:
+            if n == room:
+                m.counters[C_OVERFLOW] = 1
+                break
+            n += 1
+            nbr[row, n] = j
+    nbr[row, NB_COUNT] = n
+
+
 @njit(**BORROW)
 def build_neighbours(apos, wc, gc, m):
     """Fill the candidate lists: every pair that could touch while no pin, wheel, idler or
@@ -118,15 +174,9 @@ def build_neighbours(apos, wc, gc, m):
     for c in range(*_corner_window(apos, m, max(reach_cl, hg + skin))):
         _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
         _near_pins(corners[c, 0], corners[c, 1], apos, last, hg + skin, nbr, rows[K_CORNER_PIN] + c)
+    window = _segment_window(apos, seg, hg + skin)
     for b in range(1, last + 1):
-        row = rows[K_PIN_GROUND] + b
-        n = 0
-        for j in range(seg.shape[0]):
-            lam, s, _ = segment_coords(apos[b, 0], apos[b, 1], seg, j)
-            if lam > -skin and lam < seg[j, SEG_LENGTH] + skin and s < hg + skin:
-                n += 1
-                nbr[row, n] = j
-        nbr[row, NB_COUNT] = n
+        _pin_ground_row(apos, b, seg, window, skin, hg, m)
 
 
 @njit(**INLINE)

@@ -172,9 +172,17 @@ def neighbour_rows(n_wheels, n_corners, n_links, n_guides=0):
     return starts
 
 
+# A rough ground has thousands of segments; a pin has a few near it. On a ground of more
+# segments than this the candidate rows hold this many (a pin with more stops the run with
+# Result.GROUND_CANDIDATES) and a pin's candidates are sought within GROUND_WINDOW of the track
+# in x: the rows' memory grows with the ground's length, not with its square.
+SEGMENT_CANDIDATES = 256
+GROUND_WINDOW = 1.0      # m
+
+
 def neighbour_width(n_links, n_segments):
     """Columns of a candidate row: the count in column NB_COUNT, then the entries."""
-    return 1 + max(n_links + 1, n_segments)
+    return 1 + max(n_links + 1, min(n_segments, SEGMENT_CANDIDATES))
 
 
 NB_COUNT = 0             # column of the candidate count; entries follow in 1..count
@@ -248,7 +256,8 @@ C_REBUILDS = 0           # candidate-list rebuilds
 C_EVALUATIONS = 1        # evaluations of the track forces (stamps the pairs seen in contact)
 C_CORNER_FIRST = 2       # the ground corners within reach of the track at the last rebuild:
 C_CORNER_END = 3         # first, one past the last (a rough ground has thousands; a few matter)
-N_COUNTERS = 4
+C_OVERFLOW = 4           # 1 once a pin had more candidate segments than its row holds
+N_COUNTERS = 5
 
 # --- scalar parameters, ``par`` ---------------------------------------------------
 P_CHASSIS_MASS = 0

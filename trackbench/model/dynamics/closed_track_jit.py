@@ -21,7 +21,7 @@ work-based energy residual stays a check of the integration.
 import numpy as np
 from numba import njit
 
-from ...status import IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET
+from ...status import GROUND_CANDIDATES, IDLER_OFF_GUIDE, PIN_THROUGH_SPROCKET
 from ..contact.laws import DAMPING_NONE, DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ..contact.laws_jit import normal_force
 from ..contact.neighbours import refresh_neighbours
@@ -29,6 +29,7 @@ from ..contact.track_contacts import contact_law, round_on_track, wheel_contacts
 from ..core.bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COLS, ARM_D, ARM_Q, LOOP_IDLER, LOOP_SPROCKET
 from ..core.indices import (
     C_EVALUATIONS,
+    C_OVERFLOW,
     D_DISSIPATION,
     D_DRAWBAR,
     D_DRIVE_TORQUE,
@@ -252,6 +253,8 @@ def closed_loads(w, m, diag):
     diag[D_DISSIPATION] = 0.0
     m.counters[C_EVALUATIONS] += 1
     refresh_neighbours(w.apos, w.wc, w.gc, m)
+    if m.counters[C_OVERFLOW]:   # a pin's candidate row overflowed: its contacts are incomplete
+        diag[D_STATUS] = GROUND_CANDIDATES
     link_tensions(w.apos, w.avel, par, w.lk, w.fpin, diag, diag_tension(w.wc.shape[0]))
     wheel_contacts(w, m, diag, mem)
     _guide_contacts(w, m, diag, mem)

@@ -150,6 +150,22 @@ def _standing(x, h, eq, pad_ground):
     return h - under[0]
 
 
+def _check_memory_laws(scenario, ground):
+    """The restitution laws remember each pin's approach speed per ground segment, which a
+    candidate row holds for at most SEGMENT_CANDIDATES segments (model/core/indices.py)."""
+    from ..contact.laws import DAMPING_HUNT_CROSSLEY, DAMPINGS
+    from ..core.indices import SEGMENT_CANDIDATES
+
+    damping = scenario["contact.damping"]
+    n = ground.segments.shape[0]
+    if DAMPINGS[damping] >= DAMPING_HUNT_CROSSLEY and n > SEGMENT_CANDIDATES:
+        raise ValueError(
+            f"contact.damping = {damping!r} cannot run on this ground of {n} segments: the restitution "
+            f"laws remember a contact per ground segment, up to {SEGMENT_CANDIDATES}; allowed on rough "
+            "ground: contact.damping = 'viscous' (the damped preset's) or 'none'"
+        )
+
+
 def build_ground(scenario, eq):
     """Terrain polyline of the scenario, with obstacles placed by time resolved."""
     t = scenario["terrain"]
@@ -160,7 +176,9 @@ def build_ground(scenario, eq):
     if t["kind"] in ("random", "profile"):
         x, h = rough_points(t)
         h = _standing(x, h, eq, scenario["track.pad_ground"])
-        return ground_from_points(np.column_stack([x, h]), merge_straight=True), {}
+        ground = ground_from_points(np.column_stack([x, h]), merge_straight=True)
+        _check_memory_laws(scenario, ground)
+        return ground, {}
     obstacles = t["obstacles"] if t["kind"] == "sequence" else [t]
     pts = [[-FAR, 0.0]]
     level = 0.0
