@@ -67,9 +67,12 @@ _FRAME_BLOCK = 2048  # frames per block when working out the side view (keeps te
 
 
 def record_settings(ds):
-    """(enabled, every) from the run's scenario (attrs['scenario'], JSON)."""
-    rec = G.scenario_of(ds).get("record", {})
-    return bool(rec.get("enabled", True)), int(rec.get("every", 1))
+    """(enabled, every: output samples per side-view frame) from the run's scenario
+    (attrs['scenario'], JSON): record.every, or frames at record.fps."""
+    from ..storage import frame_step
+    sc = G.scenario_of(ds)
+    rec = sc.get("record", {})
+    return bool(rec.get("enabled", True)), frame_step(rec, sc.get("output_interval", 1e-4))
 
 
 def frame_indices(n, every):

@@ -13,7 +13,8 @@ A solver is a module with ``run(scenario, model, y0) -> RunResult`` that:
 3. controls its step by an error estimate and never steps over a contact switch: an onset
    or release inside a rejected step is located (solvers/common/events.py) and the retry
    ends just after it;
-4. fills ``Outputs`` (``allocate_outputs``): samples at t_k = k output_interval from its
+4. chooses its step by its error control alone (up to ``max_step`` where set), whatever the
+   output interval, and fills ``Outputs`` (``allocate_outputs``): samples at t_k = k output_interval from its
    dense output between accepted steps, the peaks over every accepted step
    (solvers/common/monitor.py update_peaks, so no impulse between samples is missed), the
    statistics (indices.S_*: steps, rejected steps, right-hand sides, status, t_final);
@@ -62,10 +63,13 @@ class RunResult:
 
 
 def control(scenario):
+    """The step is the error control's alone, whatever the output interval (samples come from
+    the dense output), up to ``max_step`` where a scenario sets one (0: none)."""
     tol = scenario["tolerance"]
-    dt_out = scenario["output_interval"]
-    return Control(float(scenario["duration"]), float(dt_out), float(tol), float(tol), min(H0, dt_out),
-                   float(dt_out), H_MIN, int(scenario["max_steps"]))
+    t_end = float(scenario["duration"])
+    h_max = float(scenario["max_step"]) or t_end
+    return Control(t_end, float(scenario["output_interval"]), float(tol), float(tol), min(H0, h_max),
+                   h_max, H_MIN, int(scenario["max_steps"]))
 
 
 def n_samples(scenario):

@@ -1,0 +1,81 @@
+"""Steps chosen by the error control alone, samples from the dense output, and the output
+rates of ride runs (docs/usage.md, "Output rates")."""
+
+import numpy as np
+import pytest
+
+import trackbench as tb
+from trackbench.solvers.base import control
+from trackbench.storage import frame_step
+
+FLAT = {"terrain": {"kind": "flat"}, "duration": 0.2}
+
+
+@pytest.fixture(scope="module")
+def flat_runs():
+    """The flat run sampled at 1e-4 s and at 1e-3 s, and capped at 1e-4 s as before."""
+    return {
+        "fine": tb.simulate(tb.Scenario.from_dict({**FLAT, "output_interval": 1e-4})),
+        "coarse": tb.simulate(tb.Scenario.from_dict({**FLAT, "output_interval": 1e-3})),
+        "capped": tb.simulate(tb.Scenario.from_dict({**FLAT, "output_interval": 1e-4, "max_step": 1e-4})),
+    }
+
+
+def test_steps_do_not_depend_on_the_output_interval(flat_runs):
+    fine, coarse = flat_runs["fine"], flat_runs["coarse"]
+    assert fine.attrs["steps"] == coarse.attrs["steps"]
+    assert fine.attrs["rejected_steps"] == coarse.attrs["rejected_steps"]
+    assert fine.attrs["max_step"] > 1e-3   # no longer held to either output interval
+    assert fine.sizes["time"] == 2001 and coarse.sizes["time"] == 201
+    # the same dense output read at the same times (the times differ in their last bits)
+    for name in ("chassis_y", "pin_y", "wheel_force_y"):
+        a, b = fine[name].values[::10], coarse[name].values
+        assert np.allclose(a, b, rtol=1e-12, atol=1e-9), name
+    # peaks are found along the steps, not read from the samples: the same whatever the sampling
+    for name in ("peak_wheel_force_y", "peak_link_tension", "min_chassis_vx", "max_energy_residual"):
+        assert np.array_equal(fine[name].values, coarse[name].values), name
+
+
+def test_free_samples_agree_with_the_capped_run_to_the_tolerance(flat_runs):
+    free, capped = flat_runs["fine"], flat_runs["capped"]
+    assert free.attrs["steps"] < capped.attrs["steps"] / 3
+    tol = free.attrs["tolerance"]
+    for name in ("chassis_y", "chassis_pitch", "pin_x", "pin_y", "chassis_vy", "wheel_y"):
+        diff = float(np.nanmax(np.abs(free[name].values - capped[name].values)))
+        assert diff < 2 * tol, (name, diff)   # absolute tolerance 1e-9 (m, rad, m/s)
+
+
+def test_the_paper_preset_keeps_its_cap_on_obstacles_only():
+    paper = tb.Scenario.paper()
+    assert control(paper).h_max == paper["output_interval"] == 1e-4
+    coarse = tb.Scenario.paper(output_interval=1e-3)
+    assert control(coarse).h_max == 1e-3   # as before: the paper's runs keep their bits
+    flat = tb.Scenario.from_dict({"terrain": {"kind": "flat"}})
+    assert flat["max_step"] == 0.0 and control(flat).h_max == flat["duration"]
+    damped = tb.Scenario.paper(preset="damped")
+    assert damped["max_step"] == 0.0
+    given = tb.Scenario.paper(preset="damped", max_step=2e-4)
+    assert control(given).h_max == 2e-4
+    # a scenario moved from flat ground onto a step takes the paper's sampling and cap again
+    moved = flat.with_overrides({"terrain": {"kind": "step", "height": 0.1}})
+    assert moved["output_interval"] == 1e-4 and moved["max_step"] == 1e-4
+
+
+def test_ride_ground_samples_and_records_at_the_ride_rates():
+    flat = tb.Scenario.from_dict({"terrain": {"kind": "flat"}})
+    assert flat["output_interval"] == 1e-3 and flat["record"]["every"] == 0
+    assert frame_step(flat["record"], flat["output_interval"]) == 20    # 50 frames a second
+    step = tb.Scenario.paper()
+    assert frame_step(step["record"], step["output_interval"]) == 5     # impacts in slow motion
+    given = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "record.fps": 30.0})
+    assert frame_step(given["record"], given["output_interval"]) == 33
+    every = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "record.every": 7, "output_interval": 1e-4})
+    assert every["output_interval"] == 1e-4 and frame_step(every["record"], 1e-4) == 7
+    assert frame_step({"every": 0, "fps": 1e4}, 1e-3) == 1   # never less than a sample a frame
+
+
+@pytest.mark.parametrize("bad", [{"max_step": -1e-3}, {"record.fps": 0.0}, {"record.every": -1}])
+def test_bad_rates_are_one_line_errors(bad):
+    with pytest.raises(tb.ScenarioError) as e:
+        tb.Scenario.from_dict(bad)
+    assert "\n" not in str(e.value) and next(iter(bad)) in str(e.value)
