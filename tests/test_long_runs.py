@@ -79,3 +79,102 @@ def test_bad_rates_are_one_line_errors(bad):
     with pytest.raises(tb.ScenarioError) as e:
         tb.Scenario.from_dict(bad)
     assert "\n" not in str(e.value) and next(iter(bad)) in str(e.value)
+
+
+def _prepared(scenario):
+    from trackbench.simulate import prepare
+    return prepare(scenario)
+
+
+@pytest.mark.parametrize("overrides", [
+    {"terrain": {"kind": "flat"}, "duration": 5.0},                                       # dopri5, 2 chunks
+    {"preset": "damped", "duration": 0.3, "output_interval": 5e-5, "method": "ark436l2sa"},  # IMEX, 2 chunks
+])
+def test_a_run_in_chunks_is_the_run_in_one_piece(overrides):
+    """The loop pauses when its chunk is full and resumes with the same step: the samples,
+    peaks, first contacts and statistics are those of the run in one piece, bit for bit."""
+    sc = tb.Scenario.from_dict(overrides)
+    model, _, _, _, y0, run = _prepared(sc)
+    whole = run(sc, model, y0)
+    model, _, _, _, y0, run = _prepared(sc)
+    bases, ys, ds = [], [], []
+
+    def sink(base, y, diag, stats, peaks):
+        bases.append(base)
+        ys.append(y.copy())
+        ds.append(diag.copy())
+
+    part = run(sc, model, y0, sink=sink)
+    assert len(bases) == 2 and bases[0] == 0 and bases[1] == ys[0].shape[0]
+    assert np.array_equal(whole.y, np.concatenate(ys), equal_nan=True)
+    assert np.array_equal(whole.diag, np.concatenate(ds), equal_nan=True)
+    assert np.array_equal(whole.peaks, part.peaks, equal_nan=True)
+    assert np.array_equal(whole.stats, part.stats)
+
+
+@pytest.fixture(scope="module")
+def long_flat():
+    return tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 5.0})
+
+
+def test_a_streamed_file_reads_back_as_the_run(long_flat, tmp_path):
+    import xarray as xr
+
+    from trackbench.stream import stream_run, streamable
+    assert streamable(long_flat) and not streamable(long_flat, "compact")
+    assert not streamable(tb.Scenario.paper(duration=0.2))   # one chunk: built in memory
+    path, ok = stream_run(long_flat, tmp_path / "run.nc", tmp_path / "run.failed.nc")
+    assert ok and path == tmp_path / "run.nc" and [p.name for p in tmp_path.iterdir()] == ["run.nc"]
+    ds = tb.simulate(long_flat)
+    with xr.open_dataset(path) as f:
+        assert set(f.variables) == set(ds.variables)
+        for name in ds.variables:
+            assert np.array_equal(ds[name].values, f[name].values, equal_nan=True), name
+        for k, v in ds.attrs.items():
+            if k not in ("wall_time", "solve_time"):
+                assert f.attrs[k] == v, k
+
+
+def test_a_stream_that_stops_leaves_no_file(long_flat, tmp_path, monkeypatch):
+    import trackbench.stream as S
+    calls = []
+
+    def broken(self, ds):   # the second chunk never arrives (as a run killed halfway)
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return original(self, ds)
+
+    original = S._Appender.append
+    monkeypatch.setattr(S._Appender, "append", broken)
+    with pytest.raises(KeyboardInterrupt):
+        S.stream_run(long_flat, tmp_path / "run.nc", tmp_path / "run.failed.nc")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_streamed_run_that_fails_is_kept_as_failed(tmp_path):
+    from trackbench.stream import stream_run
+    sc = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 5.0, "max_steps": 10_000})
+    path, ok = stream_run(sc, tmp_path / "run.nc", tmp_path / "run.failed.nc")
+    assert not ok and path.name == "run.failed.nc" and not (tmp_path / "run.nc").exists()
+
+
+def test_a_long_recording_is_written_block_by_block(tmp_path):
+    """More samples than a block: every sample's plot row and every 20th sample's frame (and
+    the last), in time order."""
+    from rerun.chunk import RrdReader
+
+    from trackbench.replay import entities as E
+    from trackbench.replay import record as R
+    ds = tb.simulate(tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 9.0}))
+    n = ds.sizes["time"]
+    assert n > R.RECORD_BLOCK
+    path = R.maybe_write_recording(ds, tmp_path, name="run.rrd")
+    times = {E.E_CHASSIS: [], E.E_WHEEL_FY: []}
+    for c in RrdReader(path).stream().to_chunks():
+        if c.entity_path in times and E.TIMELINE in c.timeline_names:
+            col = c.to_record_batch().column(E.TIMELINE).to_pylist()
+            times[c.entity_path] += [t.total_seconds() if hasattr(t, "total_seconds") else t for t in col]
+    frames, rows = sorted(times[E.E_CHASSIS]), sorted(times[E.E_WHEEL_FY])
+    assert len(rows) == n and len(frames) == len(range(0, n, 20)) + (0 if (n - 1) % 20 == 0 else 1)
+    assert np.allclose(frames[:3], [0.0, 0.02, 0.04]) and frames[-1] == pytest.approx(float(ds.time[-1]))
