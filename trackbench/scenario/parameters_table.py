@@ -75,8 +75,10 @@ RULES = {
     "solver": (str, SOLVERS, None, "one of " + ", ".join(SOLVERS)),
     "method": (str, METHODS, None, "one of " + ", ".join(METHODS)),
     "tolerance": (float, 1e-14, 1e-3, "a number in [1e-14, 1e-3]"),
-    "output_interval": _POS,
-    "max_step": (float, 0.0, 1000.0, "a number in [0, 1000] s (0: no cap, the error control alone)"),
+    "output_interval": (float, 0.0, math.inf,
+                        "a number > 0 (s; default 1e-4 on obstacles, 1e-3 on flat ground)"),
+    "max_step": (float, 0.0, 1000.0, "a number in [0, 1000] s (0: no cap, the error control alone; "
+                 "default: the output interval for the paper preset on obstacles, else 0)"),
     "max_steps": (int, 1, 10**9, "an integer >= 1"),
     "perturbation": (float, 0.0, 1e-3, "a number in [0, 1e-3] m"),
     "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
