@@ -18,7 +18,7 @@ PAPER_FIRST_CONTACT_TIME = 0.0568  # s: also the default of a first obstacle giv
 # The grounds a run rides over rather than meets obstacles on: what is read of them is the
 # ride (accelerations up to the 80 Hz of the Wk weighting, over 10-60 s), not the shape of
 # impacts lasting a millisecond or two. Their defaults (check_run.apply_sampling): samples
-# at RIDE_OUTPUT_INTERVAL (12 samples a period at 80 Hz; a 60 s run writes ~34 MB) and
+# at RIDE_OUTPUT_INTERVAL (12 samples a period at 80 Hz; a 60 s run writes ~36 MB) and
 # recording frames at RIDE_FPS (a screen's rate; every 20th sample, so each frame is a
 # sample of the dense output). On obstacles the paper's 1e-4 s and every 5th sample stay:
 # sampled at 1e-3 s the paper's wheel-force histories miss 13-24 % of their peaks.
