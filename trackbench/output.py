@@ -80,27 +80,36 @@ def _motion(model, result, placed):
 
 
 def _seat(scenario, result, nq):
-    """The driver's seat: its vertical acceleration and the ride metrics read from it
-    (ride_metrics.py; results_schema.md says over which samples). The metrics are NaN
-    where they cannot be had: samples more than 1/250 s apart (the weightings reach 100 Hz),
-    fewer than two, or not finite (a failed run)."""
-    from .ride_metrics import MIN_RATE, ride_figures, seat_acceleration
+    """The driver's seat's vertical acceleration at the samples (ride_metrics.seat_acceleration)."""
+    from .ride_metrics import seat_acceleration
 
     q, qd, d = result.y[:, :nq], result.y[:, nq:2 * nq], result.diag
     v = scenario["vehicle"]
     a = seat_acceleration(d[:, L.D_CHASSIS_AY], d[:, L.D_CHASSIS_ALPHA], qd[:, L.Q_PITCH],
                           v["seat_x"], v["seat_y"], q[:, L.Q_PITCH])
+    text = "the seat's (vehicle.seat_x, seat_y) vertical acceleration, gravity not included"
+    return {"seat_acceleration_y": _var(T, np.asarray(a), "m s-2", text)}
+
+
+def ride_variables(scenario, a, time):
+    """The ride metrics of the seat's acceleration a at the sample times (ride_metrics.py;
+    results_schema.md says over which samples): over the whole run, so a run written chunk by
+    chunk (stream.py) gives them its whole history. NaN where they cannot be had: samples
+    more than 1/250 s apart (the weightings reach 100 Hz), fewer than two, or not finite (a
+    failed run)."""
+    from .ride_metrics import MIN_RATE, ride_figures
+
     dt = scenario["output_interval"]
     nan = float("nan")
     names = ("peak_seat_acceleration_g", "absorbed_power", "weighted_rms_acceleration", "vdv")
     fig = dict.fromkeys(names, nan)
     peak_time = nan
     if dt <= 1.0 / MIN_RATE and a.shape[0] >= 2 and np.isfinite(a).all():
-        fig = ride_figures(a, dt, 0.5 * float(result.time[-1]))
-        peak_time = float(result.time[fig.pop("peak_index")])
-    text = "the seat's (vehicle.seat_x, seat_y) vertical acceleration, gravity not included"
+        # the second half of the samples (time[-1] for a whole run; a chunk of a streamed run,
+        # stream.py, has the run's first sample in front and its own figures are not kept)
+        fig = ride_figures(a, dt, 0.5 * ((a.shape[0] - 1) * dt))
+        peak_time = float(time[fig.pop("peak_index")])
     return {
-        "seat_acceleration_y": _var(T, np.asarray(a), "m s-2", text),
         "peak_seat_acceleration_g": _var((), fig["peak_seat_acceleration_g"], "1",
                                          "max |seat acceleration| after a 30 Hz low-pass, in g"),
         "peak_seat_acceleration_g_time": _var((), peak_time, "s", "time of peak_seat_acceleration_g"),
@@ -261,6 +270,7 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
     v = _motion(model, result, placed)
     v.update(_energies(result, model.nq))
     v.update(_seat(scenario, result, model.nq))
+    v.update(ride_variables(scenario, v["seat_acceleration_y"].values, result.time))
     v.update(_peaks(result.peaks, nw, result.stats[L.S_E0]))
     if model.closed:
         v.update(closed_layout_vars(model, result, scenario, placed))

@@ -15,12 +15,25 @@ PAD_RESTITUTION = 0.75  # rubber pads and road wheels (Chrono's M113 materials)
 PAD_ZETA = 0.134        # its drop test (1 m/s, ramp 0.2 mm) rebounds with PAD_RESTITUTION (docs/model.md)
 
 
+def _paper(d):
+    """The paper's model keeps its step capped at the output interval where it meets
+    obstacles, as it ran before steps were freed from the samples: after the first impacts
+    its motion is chaotic, and a step chosen by the error control alone puts the late peaks
+    elsewhere in their 10-60 % range (the golden runs pin these sequences). On flat ground
+    nothing is chaotic; there, and with every other preset, the error control alone
+    chooses the step."""
+    terrain = d.get("terrain")
+    flat = isinstance(terrain, dict) and terrain.get("kind") == "flat"
+    return {"max_step": 0.0 if flat else d.get("output_interval", 0.0)}
+
+
 def _damped(d):
     n = int(d["vehicle"]["n_wheels"])
     arms = [0.0] * n
     for i in {0, min(1, n - 1), n - 1}:
         arms[i] = round(ARM_ZETA * ARM_CRITICAL, 0)
     return {
+        "max_step": 0.0,
         "contact.damping": "viscous",
         "contact.damping_ratio": PAD_ZETA,
         "track.link_damping": round(LINK_ZETA * LINK_CRITICAL, 0),
@@ -28,7 +41,7 @@ def _damped(d):
     }
 
 
-PRESETS = {"paper": lambda d: {}, "damped": _damped}
+PRESETS = {"paper": _paper, "damped": _damped}
 
 
 def preset_names():

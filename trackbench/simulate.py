@@ -13,11 +13,8 @@ from .scenario import Scenario, ScenarioError
 from .solvers.registry import run_function
 
 
-def simulate(scenario: Scenario, progress=None):
-    """Run one scenario; returns the Dataset (attrs['status'] is 'completed' or 'failed')."""
-    if not isinstance(scenario, Scenario):
-        scenario = Scenario.from_dict(scenario)
-    t_wall = time.perf_counter()
+def prepare(scenario):
+    """What a run starts from: (model, equilibrium, ground, resolved terrain, y0, the solver's run)."""
     eq = equilibrium(scenario)
     try:
         ground, resolved = build_ground(scenario, eq)
@@ -25,7 +22,15 @@ def simulate(scenario: Scenario, progress=None):
         raise ScenarioError(str(e)) from None
     model = Model(scenario, eq, ground)
     y0 = initial_state(scenario, eq)
-    run_solver = run_function(scenario["solver"], scenario["method"])
+    return model, eq, ground, resolved, y0, run_function(scenario["solver"], scenario["method"])
+
+
+def simulate(scenario: Scenario, progress=None):
+    """Run one scenario; returns the Dataset (attrs['status'] is 'completed' or 'failed')."""
+    if not isinstance(scenario, Scenario):
+        scenario = Scenario.from_dict(scenario)
+    t_wall = time.perf_counter()
+    model, eq, ground, resolved, y0, run_solver = prepare(scenario)
     from .output import build_dataset
     t_solve = time.perf_counter()
     result = run_solver(scenario, model, y0)

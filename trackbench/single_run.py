@@ -176,13 +176,10 @@ def run_one(sets, duration, out, name=None, force=False, storage="full"):
         )
         raise ScenarioError(f"{existing[0]} exists: {hint} (or another --out), or --force to replace it")
     from ._jitcache import CompileNotice
-    from .output import write_netcdf
     from .replay.record import maybe_write_recording
-    from .simulate import simulate
     with CompileNotice(sys.stderr) as compiled:
-        ds = simulate(sc)
+        ds, path = _run_to_file(sc, targets, storage)
     ok = ds.attrs["status"] == "completed"
-    path = write_netcdf(ds, targets[0] if ok else targets[2], storage)
     for stale in existing:
         if stale != path and not (ok and stale == targets[1]):
             stale.unlink(missing_ok=True)
@@ -196,12 +193,37 @@ def run_one(sets, duration, out, name=None, force=False, storage="full"):
         else:
             paths.append(rrd)
     text = format_summary(ds, paths)
+    ds.close()
     if compiled.seconds > 0.0:
         text += (
             f"\n  of the wall time, {compiled.seconds:.1f} s compiling "
             "(once: later runs load the model from the cache)"
         )
     return text, ok
+
+
+def _run_to_file(sc, targets, storage):
+    """(Dataset, path): a long run streamed to its file and opened from it lazily (its memory
+    does not grow with its duration: trackbench/stream.py), any other built in memory and
+    written whole."""
+    from .stream import stream_run, streamable
+    if streamable(sc, storage):
+        import netCDF4
+        import xarray as xr
+        path, _ = stream_run(sc, targets[0], targets[2])
+        # the summary and the recording read the file block by block, each chunk once: HDF5's
+        # cache (64 MB a variable by default) would keep every chunk read
+        cache = netCDF4.get_chunk_cache()
+        netCDF4.set_chunk_cache(size=1, nelems=1)
+        try:
+            return xr.open_dataset(path, cache=False), path
+        finally:
+            netCDF4.set_chunk_cache(*cache)
+    from .output import write_netcdf
+    from .simulate import simulate
+    ds = simulate(sc)
+    ok = ds.attrs["status"] == "completed"
+    return ds, write_netcdf(ds, targets[0] if ok else targets[2], storage)
 
 
 def parameter_table():

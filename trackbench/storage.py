@@ -41,6 +41,16 @@ def check_storage(value, where="--storage"):
     return value
 
 
+def frame_step(record, output_interval):
+    """Output samples per side-view frame: record.every, or 0 there for frames at record.fps,
+    the nearest whole number of samples (at least 1): every frame is a sample of the dense
+    output, none an interpolation between samples."""
+    every = int(record.get("every", 1))
+    if every > 0:
+        return every
+    return max(1, round(1.0 / (float(record.get("fps", 50.0)) * float(output_interval))))
+
+
 def recording_steps(every, storage="full"):
     """(side-view frame step, time-series step) of a recording: compact storage thins both,
     full keeps the scenario's record.every and every sample of the time series."""

@@ -170,14 +170,19 @@ def closed_parts(lay, outline, x, y, pitch, sprocket_angle, idler_x, idler_y):
     }
 
 
-def covered_x_range(ds):
-    """x range the track covers during the run, with GROUND_MARGIN each side."""
-    px = ds.variables["pin_x"].values
-    wx = ds.variables["wheel_x"].values
+def covered_x_range(ds, block=8192):
+    """x range the track covers during the run, with GROUND_MARGIN each side (read block by
+    block of samples: a long run's file opened lazily is never read whole)."""
     r = float(ds.attrs["wheel_radius"])
-    lo = min(np.nanmin(px), np.nanmin(wx) - r) - GROUND_MARGIN
-    hi = max(np.nanmax(px), np.nanmax(wx) + r) + GROUND_MARGIN
-    return float(lo), float(hi)
+    n = ds.sizes["time"]
+    lo, hi = np.inf, -np.inf
+    for a in range(0, max(n, 1), block):
+        part = ds if n <= block else ds.isel(time=slice(a, a + block))
+        px = part.variables["pin_x"].values
+        wx = part.variables["wheel_x"].values
+        lo = min(lo, np.nanmin(px), np.nanmin(wx) - r)
+        hi = max(hi, np.nanmax(px), np.nanmax(wx) + r)
+    return float(lo - GROUND_MARGIN), float(hi + GROUND_MARGIN)
 
 
 def ground_vertices(ds):

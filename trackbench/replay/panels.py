@@ -94,6 +94,13 @@ def solver_text(ds):
     return text
 
 
+def playback_speed(ds):
+    """Real time where the side view is at a screen's frame rate (record.fps: ride runs), else
+    PLAYBACK_SPEED, the slow motion that shows an impact frame by frame."""
+    rec = G.scenario_of(ds).get("record", {})
+    return 1.0 if rec.get("every", 1) == 0 else PLAYBACK_SPEED
+
+
 def blueprint(ds):
     """Side view large on the left; wheel forces, chassis acceleration and velocity on the
     right; energies, link tension and the text documents in tabs below them. A closed-layout
@@ -132,5 +139,5 @@ def blueprint(ds):
         rrb.Horizontal(side, plots, column_shares=[3, 2]),
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
-        rrb.TimePanel(state="expanded", timeline=TIMELINE, playback_speed=PLAYBACK_SPEED),
+        rrb.TimePanel(state="expanded", timeline=TIMELINE, playback_speed=playback_speed(ds)),
     )

@@ -64,12 +64,18 @@ _VEC2_TYPE = rr.components.Position2DBatch._ARROW_DATATYPE   # fixed_size_list<f
 _COLOR_TYPE = rr.components.ColorBatch._ARROW_DATATYPE       # uint32 0xRRGGBBAA
 _SCALAR_TYPE = rr.components.ScalarBatch._ARROW_DATATYPE     # float64
 _FRAME_BLOCK = 2048  # frames per block when working out the side view (keeps temporaries small)
+# samples logged at a time: a long run's recording is worked out and streamed to its file
+# block by block (from a file opened lazily, only a block is read), its memory that of a block
+RECORD_BLOCK = 8192
 
 
 def record_settings(ds):
-    """(enabled, every) from the run's scenario (attrs['scenario'], JSON)."""
-    rec = G.scenario_of(ds).get("record", {})
-    return bool(rec.get("enabled", True)), int(rec.get("every", 1))
+    """(enabled, every: output samples per side-view frame) from the run's scenario
+    (attrs['scenario'], JSON): record.every, or frames at record.fps."""
+    from ..storage import frame_step
+    sc = G.scenario_of(ds)
+    rec = sc.get("record", {})
+    return bool(rec.get("enabled", True)), frame_step(rec, sc.get("output_interval", 1e-4))
 
 
 def frame_indices(n, every):
@@ -160,11 +166,10 @@ def _log_static(rec, ds):
                                                     labels=["soil surface (rut so far)"]), static=True)
 
 
-def _log_signals(rec, ds, every=1):
-    """Time series at every output frame (keeps the peaks), or at every ``every``-th (and the
-    last: compact storage). Multi-series entities (wheel forces, energies) hold one scalar per
-    series per row."""
-    idx = None if every == 1 else frame_indices(ds.sizes["time"], every)
+def _log_signals(rec, ds, idx=None):
+    """Time series at every output frame (idx None: keeps the peaks), or at the frames idx
+    (compact storage: every k-th and the last). Multi-series entities (wheel forces,
+    energies) hold one scalar per series per row."""
     t = [
         rr.TimeColumn(
             TIMELINE, duration=np.asarray(_rows(ds.variables["time"].values, idx), dtype=np.float64)
@@ -363,7 +368,10 @@ def write_recording(ds, path, every=1, signal_every=1):
     signal_every: the same for the time series (1, every frame, keeps their peaks)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    idx = frame_indices(ds.sizes["time"], int(every))
+    n = ds.sizes["time"]
+    idx = frame_indices(n, int(every))
+    signals = None if int(signal_every) == 1 else frame_indices(n, int(signal_every))
+    block = n if S.is_soil(ds) else RECORD_BLOCK   # the soil's surface is rebuilt from the whole run
     sc = G.scenario_of(ds)
     rec = rr.RecordingStream("trackbench", recording_id=str(uuid.uuid4()), send_properties=True)
     with atomic_path(path) as tmp:
@@ -372,13 +380,24 @@ def write_recording(ds, path, every=1, signal_every=1):
             rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
             # rerun encodes what was sent on its own thread while the next entity is prepared:
             # the time series first (nothing to prepare), then the geometry
-            _log_signals(rec, ds, int(signal_every))
-            _log_frames(rec, ds, idx)
+            for a in range(0, n, max(block, 1)):
+                part = ds if block >= n else ds.isel(time=slice(a, a + block))
+                _log_signals(rec, part, _within(signals, a, block))
+                frames = _within(idx, a, block)
+                if len(frames):
+                    _log_frames(rec, part, frames)
             _log_static(rec, ds)
             rec.flush()
         finally:
             rec.disconnect()
     return path
+
+
+def _within(idx, a, block):
+    """The indices idx in [a, a + block), counted from a (None stays None: every sample)."""
+    if idx is None:
+        return None
+    return idx[(idx >= a) & (idx < a + block)] - a
 
 
 def maybe_write_recording(ds, folder, name=RECORDING_NAME, storage="full"):

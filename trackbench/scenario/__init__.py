@@ -17,7 +17,7 @@ class ScenarioError(ValueError):
 
 # below ScenarioError: the check modules import it from this package
 from .check_closed import check_closed  # noqa: E402
-from .check_run import apply_preset, check_extensions, check_sampling  # noqa: E402
+from .check_run import apply_preset, apply_sampling, check_extensions, check_sampling  # noqa: E402
 from .check_terrain import check_placed_by_time, validate_terrain  # noqa: E402
 from .check_values import check_value, dotted_keys, flatten, merge, set_dotted, unknown  # noqa: E402
 from .check_vehicle import check_geometry  # noqa: E402
@@ -86,6 +86,7 @@ class Scenario:
         merge(d, nested)
         explicit = frozenset(explicit | dotted_keys(nested))
         d["preset"] = check_value("preset", d.get("preset"), RULES["preset"])
+        apply_sampling(d, explicit)   # first: the paper preset's step cap follows the output interval
         apply_preset(d, explicit)
         return cls(validate(d, explicit), explicit)
 

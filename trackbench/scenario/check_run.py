@@ -7,7 +7,7 @@ import math
 from ..presets import PRESETS, preset_values
 from . import ScenarioError
 from .check_values import flatten, set_dotted
-from .parameters_table import paper_step
+from .parameters_table import RIDE_KINDS, RIDE_OUTPUT_INTERVAL, paper_step
 
 
 def apply_preset(d, explicit):
@@ -20,6 +20,18 @@ def apply_preset(d, explicit):
         controlled |= set(preset_values(name, d))
     for name in controlled - set(explicit):
         set_dotted(d, name, copy.deepcopy(values.get(name, paper[name])))
+
+
+def apply_sampling(d, explicit):
+    """On ride ground (parameters_table.RIDE_KINDS) the samples and the recording's frames
+    default to the ride's rates; on obstacles to the paper's. Explicit values win."""
+    terrain = d.get("terrain")
+    ride = isinstance(terrain, dict) and terrain.get("kind") in RIDE_KINDS
+    paper = paper_step()
+    if "output_interval" not in explicit:
+        d["output_interval"] = RIDE_OUTPUT_INTERVAL if ride else paper["output_interval"]
+    if "record.every" not in explicit and isinstance(d.get("record"), dict):
+        d["record"]["every"] = 0 if ride else paper["record"]["every"]
 
 
 def check_sampling(out):

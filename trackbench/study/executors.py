@@ -22,7 +22,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from ..quantities import run_summary
-from ..storage import recording_steps
+from ..storage import frame_step, recording_steps
 from . import store
 from .warming import WARM, compile_flag
 
@@ -44,7 +44,8 @@ def _record(ds, rdir, scenario, storage="full"):
         target = Path(rdir) / "recording.rrd"
         tmp = store.tmp_path(target) + ".rrd"
         try:   # a writer of its own temporary: whatever happens inside, only a finished file lands
-            frames, signals = recording_steps(scenario["record"].get("every", 1), storage)
+            every = frame_step(scenario["record"], scenario["output_interval"])
+            frames, signals = recording_steps(every, storage)
             write_recording(ds, tmp, every=frames, signal_every=signals)
             os.replace(tmp, target)
         finally:

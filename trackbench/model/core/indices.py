@@ -391,3 +391,25 @@ S_H_MIN = 6
 S_H_MAX = 7
 S_E0 = 8                 # initial total energy: kinetic + elastic (J)
 N_STATS = 9
+
+# The time loop's state kept between the calls of a run streamed in chunks (Outputs.resume,
+# solvers/common/stepping.py): whether it started and is paused, the sample of the chunk's row
+# 0, the samples so far, then what the loop carries from step to step.
+RS_STARTED = 0
+RS_PAUSED = 1
+RS_BASE = 2
+RS_N_OUT = 3
+RS_T = 4
+RS_H = 5
+RS_STEPS = 6
+RS_REJECTED = 7
+RS_H_LO = 8
+RS_H_HI = 9
+RS_FAC_MAX = 10
+RS_AT_SWITCH = 11
+RS_E_REF = 12
+RS_R_REF = 13
+RS_N_RHS = 14
+RS_AGE = 15       # the IMEX loop's: steps since its Jacobian, rejections in a row
+RS_IN_ROW = 16
+N_RUN_STATE = 17

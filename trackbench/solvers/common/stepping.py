@@ -12,12 +12,36 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import remember_onsets
-from ...model.core.indices import D_E_GRAVITY, D_STATUS, N_Y_EXTRA, PN_NQ, Q_X, S_E0, Y_WORK
+from ...model.core.indices import (
+    D_E_GRAVITY,
+    D_STATUS,
+    N_Y_EXTRA,
+    PN_NQ,
+    Q_X,
+    RS_AT_SWITCH,
+    RS_BASE,
+    RS_E_REF,
+    RS_FAC_MAX,
+    RS_H,
+    RS_H_HI,
+    RS_H_LO,
+    RS_N_OUT,
+    RS_N_RHS,
+    RS_PAUSED,
+    RS_R_REF,
+    RS_REJECTED,
+    RS_STARTED,
+    RS_STEPS,
+    RS_T,
+    S_E0,
+    Y_WORK,
+)
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import has_ground_memory, remember_ground
 from ...status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
+from .control import loop_start
 from .hermite import hermite_second_order
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
 from .sinkage import remember_inside_step
@@ -62,18 +86,63 @@ def loop_first(y0, m, w, lw, out):
 
 
 @njit(**INLINE)
-def samples(t, h, n_out, dt_out, m, w, lw, out):
-    """Output samples in (t, t + h] by Hermite interpolation; returns the new sample count."""
+def loop_resume(y0, h0, m, w, lw, out):
+    """The loop's state: at t = 0 (loop_first) on a run's first call, else where its last call
+    paused (keep_state). Returns (status, (t, h, n_out, n_rhs), (steps, rejected, h_lo, h_hi,
+    fac_max, at_switch), (e_ref, r_ref))."""
+    rs = out.resume
+    if rs[RS_STARTED] == 0.0:
+        status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
+        rs[RS_STARTED] = 1.0
+        t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
+        return status, (t, h0, 1, 1), (steps, rejected, h_lo, h_hi, fac_max, at_switch), (e_ref, r_ref)
+    rs[RS_PAUSED] = 0.0
+    counts = (int(rs[RS_STEPS]), int(rs[RS_REJECTED]), rs[RS_H_LO], rs[RS_H_HI], rs[RS_FAC_MAX],
+              rs[RS_AT_SWITCH] != 0.0)
+    return SUCCESSFUL, (rs[RS_T], rs[RS_H], int(rs[RS_N_OUT]), int(rs[RS_N_RHS])), counts, (rs[RS_E_REF],
+                                                                                          rs[RS_R_REF])
+
+
+@njit(**INLINE)
+def keep_state(rs, at, counts, refs):
+    """Pause: the loop's state into rs (Outputs.resume) for loop_resume; at = (t, h, n_out, n_rhs)."""
+    rs[RS_PAUSED] = 1.0
+    rs[RS_T], rs[RS_H], rs[RS_N_OUT], rs[RS_N_RHS] = at
+    steps, rejected, h_lo, h_hi, fac_max, at_switch = counts
+    rs[RS_STEPS], rs[RS_REJECTED] = steps, rejected
+    rs[RS_H_LO], rs[RS_H_HI], rs[RS_FAC_MAX] = h_lo, h_hi, fac_max
+    rs[RS_AT_SWITCH] = 1.0 if at_switch else 0.0
+    rs[RS_E_REF], rs[RS_R_REF] = refs
+
+
+@njit(**INLINE)
+def chunk_full(t, h, n_out, ctl, out):
+    """Whether the samples a step from t to t + h would take overrun the chunk (out.y's rows,
+    row 0 being sample out.resume[RS_BASE]): the loop then pauses before the step and tries the
+    same step when resumed, so a run streamed in chunks takes the steps of a run in one piece."""
+    n = n_out
+    t_new = t + h
+    while n < ctl.n_samples and n * ctl.dt_out <= t_new * (1.0 + 1e-12):
+        n += 1
+    return n - int(out.resume[RS_BASE]) > out.y.shape[0]
+
+
+@njit(**INLINE)
+def samples(t, h, n_out, ctl, m, w, lw, out):
+    """Output samples in (t, t + h] by Hermite interpolation into the chunk's rows; returns the
+    new sample count."""
     y, K, y_new, ys, fs = lw.y, lw.K, lw.y_new, lw.ys, lw.fs
     out_y, out_diag = out.y, out.diag
     nq = m.pins[PN_NQ]
     s = K.shape[0] - 1
     t_new = t + h
-    while n_out < out_y.shape[0] and n_out * dt_out <= t_new * (1.0 + 1e-12):
+    dt_out = ctl.dt_out
+    base = int(out.resume[RS_BASE])
+    while n_out < ctl.n_samples and n_out * dt_out <= t_new * (1.0 + 1e-12):
         theta = min(1.0, (n_out * dt_out - t) / h)
         hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
-        set_row(out_y, n_out, ys)
-        rhs(ys, m, w, fs, out_diag[n_out])
+        set_row(out_y, n_out - base, ys)
+        rhs(ys, m, w, fs, out_diag[n_out - base])
         n_out += 1
     return n_out
 
@@ -127,7 +196,7 @@ def accept_step(t, h, n_out, step_refs, m, w, ev, lw, ctl, out):
     remember_onsets(m, w)
     if memory:
         keep_end(w, lw.end)
-    n_new = samples(t, h, n_out, ctl.dt_out, m, w, lw, out)
+    n_new = samples(t, h, n_out, ctl, m, w, lw, out)
     if memory:
         remember_inside_step(y, K[0], y_new, K[s], h, m, ev, lw.end)   # the soil's, along the step
         remember_ground(m, lw.end)  # from the accepted end state, after the samples inside the step

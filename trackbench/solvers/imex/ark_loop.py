@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step
-from ...model.core.indices import PN_NQ
+from ...model.core.indices import PN_NQ, RS_AGE, RS_IN_ROW, RS_N_OUT
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...status import SUCCESSFUL
@@ -31,11 +31,10 @@ from ..common.control import (
     before_step,
     counted,
     finish_stats,
-    loop_start,
 )
 from ..common.events import first_contact_switch
 from ..common.pin_jacobian import J_AGE, J_REJECTIONS, factor, pin_jacobian, solve, times_j
-from ..common.stepping import accept_step, end_of_step, error_norm, loop_first
+from ..common.stepping import accept_step, chunk_full, end_of_step, error_norm, keep_state, loop_resume
 
 ArkWork = namedtuple("ArkWork", [
     "K",      # (stages + 1, ny) F_i = f(y + Z_i); row 0 f at the step's start, the last f at its end
@@ -53,7 +52,7 @@ ArkWork = namedtuple("ArkWork", [
 
 def loop_arrays(stages, ny, n_diag, n_pins):
     return ArkWork(np.zeros((stages + 1, ny)), np.zeros((stages, ny)), np.empty(ny), np.empty(ny),
-                   np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(n_diag),
+                   np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny), np.zeros(n_diag),
                    end_of_step(n_pins))
 
 
@@ -114,16 +113,21 @@ def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
     y, y_new, K = lw.y, lw.y_new, lw.K
     nq = m.pins[PN_NQ]
     s = tab.b.shape[0]
-    status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
-    h = min(ctl.h0, ctl.h_max)
-    n_rhs = n_out = 1
-    t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
-    age = J_AGE       # no Jacobian yet
-    in_row = 0        # rejections in a row
+    status, at, counts, refs = loop_resume(y0, min(ctl.h0, ctl.h_max), m, w, lw, out)
+    t, h, n_out, n_rhs = at
+    steps, rejected, h_lo, h_hi, fac_max, at_switch = counts
+    e_ref, r_ref = refs
+    age = int(out.resume[RS_AGE])        # J_AGE at the start: no Jacobian yet
+    in_row = int(out.resume[RS_IN_ROW])  # rejections in a row
     while status == SUCCESSFUL and t < ctl.t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, ctl.t_end, steps, rejected, ctl.max_steps, ctl.h_min)
         if status != SUCCESSFUL:
             break
+        if chunk_full(t, h, n_out, ctl, out):   # a run streamed in chunks: hand this one over
+            counts = (steps, rejected, h_lo, h_hi, fac_max, at_switch)
+            keep_state(out.resume, (t, h, n_out, n_rhs), counts, refs)
+            out.resume[RS_AGE], out.resume[RS_IN_ROW] = age, in_row
+            return
         if age >= J_AGE or in_row >= J_REJECTIONS:
             n_rhs += pin_jacobian(y, K[0], m, w, jw, lw.diag)
             age = 0
@@ -159,3 +163,4 @@ def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
         age += 1
         in_row = 0
     finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)
+    out.resume[RS_N_OUT] = n_out

@@ -13,7 +13,7 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step
-from ...model.core.indices import N_Y_EXTRA, PN_NQ
+from ...model.core.indices import N_Y_EXTRA, PN_NQ, RS_N_OUT
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...status import SUCCESSFUL
@@ -24,10 +24,9 @@ from ..common.control import (
     before_step,
     counted,
     finish_stats,
-    loop_start,
 )
 from ..common.events import first_contact_switch
-from ..common.stepping import accept_step, end_of_step, loop_first
+from ..common.stepping import accept_step, chunk_full, end_of_step, keep_state, loop_resume
 
 RkWork = namedtuple("RkWork", [
     "K",      # (stages + 1, ny) stage derivatives; row 0 = f at the step start (FSAL)
@@ -43,8 +42,10 @@ RkWork = namedtuple("RkWork", [
 
 
 def loop_arrays(stages, ny, n_diag, n_pins):
+    # diag zeroed: a layout's rhs leaves the other layout's columns alone, and the first sample
+    # copies the whole row (np.empty left it what memory held: runs that differed there)
     return RkWork(np.zeros((stages + 1, ny)), np.empty(ny), np.empty(ny), np.empty(ny), np.empty(ny),
-                  np.empty(ny), np.empty(ny), np.empty(n_diag), end_of_step(n_pins))
+                  np.empty(ny), np.empty(ny), np.zeros(n_diag), end_of_step(n_pins))
 
 
 @njit(**INLINE)
@@ -126,14 +127,18 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     rtol, atol, h_min, h_max, t_end = ctl.rtol, ctl.atol, ctl.h_min, ctl.h_max, ctl.t_end
     nq = m.pins[PN_NQ]
     s = b.shape[0]
-    status, e_ref, r_ref = loop_first(y0, m, w, lw, out)
-    h = min(ctl.h0, h_max)
-    n_rhs = n_out = 1
-    t, steps, rejected, h_lo, h_hi, fac_max, at_switch = loop_start()
+    status, at, counts, refs = loop_resume(y0, min(ctl.h0, h_max), m, w, lw, out)
+    t, h, n_out, n_rhs = at
+    steps, rejected, h_lo, h_hi, fac_max, at_switch = counts
+    e_ref, r_ref = refs
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
             break
+        if chunk_full(t, h, n_out, ctl, out):   # a run streamed in chunks: hand this one over
+            counts = (steps, rejected, h_lo, h_hi, fac_max, at_switch)
+            keep_state(out.resume, (t, h, n_out, n_rhs), counts, refs)
+            return
         _stages(h, A, b, m, w, y, K, ys, y_new, diag)
         n_rhs += s
         err = _error_norm(y, y_new, K, e, e3, h, rtol, atol, 2 * nq, er5, er3)  # (q, qd), bristles
@@ -165,3 +170,4 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         h = after_acceptance(h, err, expo, fac_max, h_max)
         fac_max = FAC_MAX
     finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)
+    out.resume[RS_N_OUT] = n_out
