@@ -55,6 +55,9 @@ E_AY = "/signals/chassis_ay"
 E_VX = "/signals/chassis_vx"
 
 
+E_SEAT = "/signals/seat_acceleration_y"  # the driver's seat, the ride metrics' input
+
+
 E_ENERGY = "/signals/energy"  # kinetic, elastic, gravity, balance per row
 
 

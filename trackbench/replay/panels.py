@@ -12,6 +12,7 @@ from .entities import (
     E_ENERGY,
     E_IDLER_FORCE,
     E_PARAMS,
+    E_SEAT,
     E_SOLVER,
     E_SPROCKET_TORQUE,
     E_TENSION,
@@ -121,6 +122,7 @@ def blueprint(ds):
         rrb.TimeSeriesView(origin=E_VX, name="chassis horizontal velocity (m/s)"),
         rrb.Tabs(
             rrb.TimeSeriesView(origin=E_ENERGY, name="energies (J)"),
+            rrb.TimeSeriesView(origin=E_SEAT, name="seat vertical acceleration (m/s^2)"),
             rrb.TimeSeriesView(origin=E_TENSION, name="max link tension (N)"),
             rrb.TextDocumentView(origin=E_PARAMS, name="parameters"),
             rrb.TextDocumentView(origin=E_SOLVER, name="solver"),

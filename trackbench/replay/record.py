@@ -39,6 +39,7 @@ from .entities import (
     E_PARAMS,
     E_PINS,
     E_ROLLERS,
+    E_SEAT,
     E_SOIL,
     E_SOLVER,
     E_SPROCKET,
@@ -155,7 +156,7 @@ def _log_static(rec, ds):
     rec.log(E_GROUND, rr.LineStrips2D([_flip(G.ground_polyline(ds))], colors=[GROUND_RGB], radii=[0.015],
                                       labels=["ground"]), static=True)
     for e in (E_CHASSIS, E_ARMS, E_WHEELS, E_LINKS, E_PINS, E_WHEEL_FORCE, E_GROUND_FORCE,
-              E_WHEEL_FY, E_AY, E_VX, E_ENERGY, E_TENSION):
+              E_WHEEL_FY, E_AY, E_SEAT, E_VX, E_ENERGY, E_TENSION):
         rec.log(e, styles[e], static=True)
     rec.log(E_PARAMS, rr.TextDocument(parameters_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
     rec.log(E_SOLVER, rr.TextDocument(solver_text(ds), media_type=rr.MediaType.MARKDOWN), static=True)
@@ -184,6 +185,7 @@ def _log_signals(rec, ds, idx=None):
 
     rec.send_columns(E_WHEEL_FY, indexes=t, columns=scalars(ds.variables["wheel_force_y"].values))
     rec.send_columns(E_AY, indexes=t, columns=scalars(ds.variables["chassis_ay"].values))
+    rec.send_columns(E_SEAT, indexes=t, columns=scalars(ds.variables["seat_acceleration_y"].values))
     rec.send_columns(E_VX, indexes=t, columns=scalars(ds.variables["chassis_vx"].values))
     e = np.stack([ds.variables[var].values for _, var, _ in ENERGY_SERIES], axis=1)
     rec.send_columns(E_ENERGY, indexes=t, columns=scalars(e))

@@ -19,6 +19,7 @@ from .entities import (
     E_LINKS,
     E_PINS,
     E_ROLLERS,
+    E_SEAT,
     E_SPROCKET,
     E_SPROCKET_TORQUE,
     E_TENSION,
@@ -61,6 +62,7 @@ def _static_styles(nw, r):
         ),
         E_AY: rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis a_y (m/s^2)"]),
         E_VX: rr.SeriesLines(colors=[(0, 0, 0)], names=["chassis v_x (m/s)"]),
+        E_SEAT: rr.SeriesLines(colors=[(178, 34, 34)], names=["seat a_y (m/s^2)"]),
         E_ENERGY: rr.SeriesLines(
             colors=[rgb for _, _, rgb in ENERGY_SERIES], names=[name for name, _, _ in ENERGY_SERIES]
         ),
