@@ -175,3 +175,19 @@ def test_restitution_laws_on_a_long_ground_are_refused_in_one_line():
                                                         "contact.restitution": 0.75}))
     assert "contact.damping = 'hunt_crossley' cannot run on this ground" in str(e.value)
     assert "\n" not in str(e.value)
+
+
+def test_a_long_run_is_replayed_following_the_chassis(tmp_path, rough_run):
+    """A run covering more than 20 m of ground is seen in a window about the chassis, the
+    world moved under it frame by frame; a short run whole, as before."""
+    from trackbench.replay.geometry import follow_window
+    from trackbench.replay.record import write_recording
+
+    assert follow_window(rough_run) is None                      # 8 m covered
+    ds = tb.simulate(tb.Scenario.paper(duration=2.5, terrain={"kind": "flat"}))   # 25 m
+    lo, hi = follow_window(ds)
+    assert -4.5 < lo < -3.0 and 3.0 < hi < 4.5                   # the track and a metre each side
+    text = write_recording(ds, tmp_path / "long.rrd", every=20).read_bytes()
+    short = write_recording(rough_run, tmp_path / "short.rrd", every=20).read_bytes()
+    assert b"following the chassis" in text and b"Translation3D" in text     # the world moves
+    assert b"following the chassis" not in short and b"Translation3D" not in short

@@ -7,6 +7,7 @@ TIMELINE = "sim_time"
 PLAYBACK_SPEED = 0.05  # the viewer replays at 1/20 of real time: 0.5 s simulated takes 10 s
 
 
+E_WORLD = "/world"   # the side view's root: moved under the chassis in a long run's recording
 E_GROUND = "/world/ground"
 
 

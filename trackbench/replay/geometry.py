@@ -31,6 +31,7 @@ HULL_BOTTOM = -0.3     # m below the mass centre (chassis frame)
 HULL_TOP = 0.6         # m above the mass centre
 FORCE_SCALE = 1.0 / 200e3  # m per N: 1 m per 200 kN
 GROUND_MARGIN = 1.0    # m of ground drawn beyond the region the track covers
+FOLLOW_SPAN = 20.0     # m: a run covering more ground than this is viewed following the chassis
 _BLOCK = 8192          # elements per block in the blocked helpers: temporaries stay small and cached
 
 # link tension colour scale: (tension in N, RGB)
@@ -183,6 +184,22 @@ def covered_x_range(ds, block=8192):
         lo = min(lo, np.nanmin(px), np.nanmin(wx) - r)
         hi = max(hi, np.nanmax(px), np.nanmax(wx) + r)
     return float(lo - GROUND_MARGIN), float(hi + GROUND_MARGIN)
+
+
+def follow_window(ds):
+    """For a run covering more than FOLLOW_SPAN of ground (a ride, a long run), the side view's
+    x range about the chassis' mass centre, the track at t = 0 with GROUND_MARGIN each side
+    (the recording then moves the world under the chassis); None for a shorter run, seen whole."""
+    lo, hi = covered_x_range(ds)
+    if hi - lo <= FOLLOW_SPAN:
+        return None
+    x0 = float(ds.variables["chassis_x"].values[0])
+    first = ds.isel(time=0)
+    r = float(ds.attrs["wheel_radius"])
+    px, wx = first.variables["pin_x"].values, first.variables["wheel_x"].values
+    left = min(float(np.nanmin(px)), float(np.nanmin(wx)) - r)
+    right = max(float(np.nanmax(px)), float(np.nanmax(wx)) + r)
+    return left - x0 - GROUND_MARGIN, right - x0 + GROUND_MARGIN
 
 
 def ground_vertices(ds):

@@ -18,6 +18,7 @@ from .entities import (
     E_TENSION,
     E_VX,
     E_WHEEL_FY,
+    E_WORLD,
     PLAYBACK_SPEED,
     TIMELINE,
 )
@@ -102,19 +103,22 @@ def playback_speed(ds):
     return 1.0 if rec.get("every", 1) == 0 else PLAYBACK_SPEED
 
 
-def blueprint(ds):
+def blueprint(ds, follow=False):
     """Side view large on the left; wheel forces, chassis acceleration and velocity on the
     right; energies, link tension and the text documents in tabs below them. A closed-layout
     run adds the drive torque and the tensioner force under the side view, where the
-    sprocket and the idler they act on are seen."""
+    sprocket and the idler they act on are seen. follow: a long run's side view shows the
+    vehicle's surroundings (geometry.follow_window), the world moving under it."""
     x0, x1 = G.covered_x_range(ds)
     ground = G.ground_polyline(ds, (x0, x1))
     top = float(np.nanmax(ds.variables["chassis_y"].values)) + G.HULL_TOP + 0.5
     bottom = float(np.min(ground[:, 1])) - 0.5
+    window = G.follow_window(ds) if follow else None
     side = rrb.Spatial2DView(
-        origin="/world",
-        name="side view (x forward; up is up)",
-        visual_bounds=rrb.VisualBounds2D(x_range=[x0, x1], y_range=[-top, -bottom]),
+        origin="/" if window else E_WORLD,   # the root: /world's own transform then applies
+        contents=[E_WORLD + "/**"] if window else None,
+        name="side view (x forward; up is up)" + (", following the chassis" if window else ""),
+        visual_bounds=rrb.VisualBounds2D(x_range=list(window or (x0, x1)), y_range=[-top, -bottom]),
     )
     plots = rrb.Vertical(
         rrb.TimeSeriesView(origin=E_WHEEL_FY, name="vertical wheel-track force (N)"),

@@ -49,6 +49,7 @@ from .entities import (
     E_WHEEL_FORCE,
     E_WHEEL_FY,
     E_WHEELS,
+    E_WORLD,
     ENERGY_SERIES,
     GROUND_RGB,
     SOIL_RGB,
@@ -240,11 +241,12 @@ def _log_track(rec, t, take, n, closed=False):
     return pin_x, pin_y
 
 
-def _log_frames(rec, ds, idx):
+def _log_frames(rec, ds, idx, follow=False):
     """The side view at the frames `idx`: the same geometry as geometry.side_view, computed
     straight into float32 (y negated) buffers and Arrow arrays, one send_columns per entity.
     The track (the bulk of the data) goes first: rerun encodes it on its own thread while
-    the rest is prepared."""
+    the rest is prepared. follow (geometry.follow_window): the world moved under the chassis
+    frame by frame, so that a long run's vehicle stays in the side view."""
     idx = np.asarray(idx)
     n = len(idx)
     full = n == ds.sizes["time"] and (n == 0 or (idx[0] == 0 and idx[-1] == n - 1))
@@ -265,6 +267,10 @@ def _log_frames(rec, ds, idx):
     # centre of the pins' ground contacts: worked out in blocks of frames, straight into the
     # float32 output buffers (small temporaries: no page faults on megabytes of them)
     x, y, th = take("chassis_x"), take("chassis_y"), take("chassis_pitch")
+    if follow:
+        shift = np.zeros((n, 3), dtype=np.float32)
+        shift[:, 0] = -x        # the chassis' mass centre at x = 0 of the view
+        rec.send_columns(E_WORLD, indexes=t, columns=rr.Transform3D.columns(translation=shift))
     cos, sin = np.cos(th), np.sin(th)
     bx, by = G.hull_body(ds)
     piv = np.asarray(G.attr_json(ds, "arm_pivots"), float)
@@ -375,10 +381,11 @@ def write_recording(ds, path, every=1, signal_every=1):
     signals = None if int(signal_every) == 1 else frame_indices(n, int(signal_every))
     block = n if S.is_soil(ds) else RECORD_BLOCK   # the soil's surface is rebuilt from the whole run
     sc = G.scenario_of(ds)
+    follow = G.follow_window(ds) is not None
     rec = rr.RecordingStream("trackbench", recording_id=str(uuid.uuid4()), send_properties=True)
     with atomic_path(path) as tmp:
         try:
-            rec.save(tmp, default_blueprint=blueprint(ds))
+            rec.save(tmp, default_blueprint=blueprint(ds, follow))
             rec.send_recording_name(f"trackbench {sc.get('name', 'run')}")
             # rerun encodes what was sent on its own thread while the next entity is prepared:
             # the time series first (nothing to prepare), then the geometry
@@ -387,7 +394,7 @@ def write_recording(ds, path, every=1, signal_every=1):
                 _log_signals(rec, part, _within(signals, a, block))
                 frames = _within(idx, a, block)
                 if len(frames):
-                    _log_frames(rec, part, frames)
+                    _log_frames(rec, part, frames, follow)
             _log_static(rec, ds)
             rec.flush()
         finally:
