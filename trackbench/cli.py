@@ -151,19 +151,29 @@ def study_run(
     ),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    study = _load_study_or_fail(file, output)  # a bad study file fails here, before the solver libraries load
-    from .study.executors import check_arguments, start_workers
-    from .study.runner import check_output
-    from .study.warming import warm_kinds
+    from .study.executors import check_arguments, start_workers, stop_server
+    from .study.warming import LATER, announce, warm_kinds
     try:
         check_arguments(workers, executor, scheduler, storage)
-        check_output(study)   # a folder that cannot be written, or that holds another study's results
     except ValueError as e:
         _fail(str(e))
-    from .study import store
-    todo = [r for r in study.runs if force or not store.is_completed(study.output, r.run_id)]
-    if todo:   # the workers load (or compile) the study's models while this process imports and sets up
-        start_workers(executor, scheduler, warm=warm_kinds(r.scenario for r in todo))
+    # the workers' server first: its imports (a second) overlap the study's validation and expansion
+    start_workers(executor, scheduler, warm=LATER)
+    try:
+        study = _load_study_or_fail(file, output)
+        from .study import store
+        todo = [r for r in study.runs if force or not store.is_completed(study.output, r.run_id)]
+        announce(warm_kinds(r.scenario for r in todo))   # what the server loads (or compiles) for the workers
+        from .study.runner import check_output
+        check_output(study)   # a folder that cannot be written, or that holds another study's results
+    except ValueError as e:
+        stop_server()
+        _fail(str(e))
+    except typer.Exit:
+        stop_server()
+        raise
+    if not todo:
+        stop_server()
     from .study import StudyError, StudyLocked, run_study
     from .study.runner import report
     try:

@@ -172,7 +172,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
                 run_search(study, waves, waves.search)
         finally:
             waves.close()
-            warming.compile_flag().unlink(missing_ok=True)
+            warming.forget()
             store.clean_tmp(study.output)  # what killed workers left half-written
             _summarise(study, out)
             out.others = len(other_runs(study))
