@@ -151,8 +151,8 @@ def study_run(
     ),
 ):
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
-    from .study.executors import check_arguments, start_workers, stop_server
-    from .study.warming import LATER, announce, warm_kinds
+    from .study.executors import check_arguments
+    from .study.warming import LATER, announce, start_workers, stop_server, warm_kinds
     try:
         check_arguments(workers, executor, scheduler, storage)
     except ValueError as e:
@@ -332,6 +332,9 @@ def main():
     """The command; Click's own usage errors (an option of the wrong type, an unknown option or
     command) in one line like the command's own, instead of a framed panel."""
     import sys
+    if sys.argv[1:2] == ["run"]:   # a process that runs one scenario holds numpy arrays only
+        from .startup import without_dask_arrays
+        without_dask_arrays()
     try:
         code = app(standalone_mode=False, prog_name="trackbench")
     except _usage_error() as e:

@@ -7,7 +7,6 @@ are spawned and warm themselves up (_warm).
 Tasks and results are plain dicts (picklable, no Scenario objects)."""
 
 import errno
-import json
 import os
 import shutil
 import socket
@@ -24,8 +23,8 @@ from pathlib import Path
 
 from ..quantities import run_summary
 from ..storage import recording_steps
-from . import store, warming
-from .warming import WARM
+from . import store
+from .warming import PRELOAD, _context, start_workers, stop_server  # noqa: F401  (the pool's server)
 
 
 def _now():
@@ -264,68 +263,6 @@ def _attempt(task, number):
     """The task for try ``number``: a fresh attempt_id lets the coordinator tell this try's
     run.json from an older one (a --force rerun, an earlier try)."""
     return {**task, "attempt": number, "attempt_id": uuid.uuid4().hex}
-
-
-PRELOAD = "trackbench.study.preload"
-
-
-def _context():
-    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
-    where the platform has no fork server."""
-    import multiprocessing
-    if "forkserver" not in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("spawn")
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload([PRELOAD])
-    return ctx
-
-
-def start_workers(executor="local", scheduler=None, warm=None):
-    """Start the fork server now (it loads in its own process while the command does its own
-    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
-    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
-    in compile_flag()) before it forks a worker, or warming.LATER (the command says which
-    through warming.announce, once it has read the study); default: the paper's. Once the
-    server runs, a list is announced to it (when it waits for one)."""
-    if warm is not None and _server_pid() is not None and warm != warming.LATER:
-        warming.announce(warm)
-    elif warm is not None:
-        os.environ[WARM] = json.dumps(warming.spec(warm))
-    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
-    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
-    # pyarrow: the fork server and the workers inherit this, and so the server has a single
-    # thread when it forks (preload.py)
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
-    if scheduler:
-        return
-    ctx = _context()
-    if ctx.get_start_method() == "forkserver":
-        if executor == "dask":   # its nannies start worker processes from the same server
-            ctx.set_forkserver_preload(["distributed", PRELOAD])
-        from multiprocessing import forkserver
-        forkserver.ensure_running()
-
-
-def _server_pid():
-    """The pid of the fork server this process started, or None. Not reaped here: multiprocessing
-    finds a stopped server itself (ensure_running starts another)."""
-    from multiprocessing import forkserver
-    return getattr(forkserver._forkserver, "_forkserver_pid", None)
-
-
-def stop_server():
-    """Stop the fork server this process started (a command with nothing to run, or bad input
-    found after it started): it would otherwise finish its preload, a second of a core, for no
-    worker."""
-    import signal
-    pid = _server_pid()
-    if pid is not None:
-        try:
-            os.kill(pid, signal.SIGTERM)
-        except ProcessLookupError:
-            pass
 
 
 def _new_pool(workers):

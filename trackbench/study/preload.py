@@ -48,7 +48,8 @@ def warm():
     import tempfile
     from pathlib import Path
 
-    _without_dask_arrays()
+    from trackbench.startup import without_dask_arrays
+    without_dask_arrays()   # the pool's workers hold numpy arrays only
     import netCDF4  # noqa: F401
     import pandas  # noqa: F401  (the summary of a run's results)
     import xarray  # noqa: F401
@@ -67,17 +68,6 @@ def warm():
     run_summary(ds)
     with tempfile.TemporaryDirectory() as tmp:
         write_netcdf(ds, Path(tmp) / "warm.nc")
-
-
-def _without_dask_arrays():
-    """Workers of the process pool hold numpy arrays only, but where dask is installed xarray
-    imports dask.array (0.3-0.4 s) at the first Variable it builds, to ask whether the data are
-    dask arrays. A None in sys.modules makes that import fail, as if dask were not installed
-    (xarray then answers no, which is so). Not in dask's own workers (the dask executor
-    preloads distributed first): dask may need its arrays there."""
-    import sys
-    if "distributed" not in sys.modules:
-        sys.modules.setdefault("dask.array", None)
 
 
 def _kinds():

@@ -1,6 +1,6 @@
-"""What the command tells the workers' fork server to warm (preload.py), and where the
-server says that it compiles: the one protocol both sides share, light enough for the
-command to import (no numba).
+"""The workers' fork server from the command's side: its start and stop, what the command
+tells it to warm (preload.py) and where the server says that it compiles: the one protocol
+both sides share, light enough for the command to import (no numba).
 
 The command starts the server before it reads the study file (the server's imports, about
 a second, then overlap the validation and the expansion of the runs), so the server cannot
@@ -67,3 +67,65 @@ def forget():
     """Remove this command's files of the protocol (at its end)."""
     for p in (compile_flag(), warm_file()):
         p.unlink(missing_ok=True)
+
+
+PRELOAD = "trackbench.study.preload"
+
+
+def _context():
+    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
+    where the platform has no fork server."""
+    import multiprocessing
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload([PRELOAD])
+    return ctx
+
+
+def start_workers(executor="local", scheduler=None, warm=None):
+    """Start the fork server now (it loads in its own process while the command does its own
+    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
+    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
+    in compile_flag()) before it forks a worker, or LATER (the command says which
+    through warming.announce, once it has read the study); default: the paper's. Once the
+    server runs, a list is announced to it (when it waits for one)."""
+    if warm is not None and _server_pid() is not None and warm != LATER:
+        announce(warm)
+    elif warm is not None:
+        os.environ[WARM] = json.dumps(spec(warm))
+    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
+    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
+    # pyarrow: the fork server and the workers inherit this, and so the server has a single
+    # thread when it forks (preload.py)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
+    if scheduler:
+        return
+    ctx = _context()
+    if ctx.get_start_method() == "forkserver":
+        if executor == "dask":   # its nannies start worker processes from the same server
+            ctx.set_forkserver_preload(["distributed", PRELOAD])
+        from multiprocessing import forkserver
+        forkserver.ensure_running()
+
+
+def _server_pid():
+    """The pid of the fork server this process started, or None. Not reaped here: multiprocessing
+    finds a stopped server itself (ensure_running starts another)."""
+    from multiprocessing import forkserver
+    return getattr(forkserver._forkserver, "_forkserver_pid", None)
+
+
+def stop_server():
+    """Stop the fork server this process started (a command with nothing to run, or bad input
+    found after it started): it would otherwise finish its preload, a second of a core, for no
+    worker."""
+    import signal
+    pid = _server_pid()
+    if pid is not None:
+        try:
+            os.kill(pid, signal.SIGTERM)
+        except ProcessLookupError:
+            pass
