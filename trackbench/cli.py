@@ -218,7 +218,7 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
     if study.search is not None:   # replayed first: it adds the runs the search asks for next
         from .study.limits import search_state
         search = search_state(study)
-    counts, df = status_counts(study)
+    counts, failed = status_counts(study)
     kept = others_note(len(other_runs(study)))
     typer.echo(
         f"study {study.name}: {count(len(study.runs), 'run')}: {counts['completed']} done, "
@@ -227,8 +227,8 @@ def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its
     )
     if search:
         typer.echo(search)
-    for _, r in df[df.status == "failed"].iterrows():
-        typer.echo(f"  failed {r.run_id}: {r.status_message}")
+    for run_id, why in failed:
+        typer.echo(f"  failed {run_id}: {why}")
 
 
 # --- replay commands ---------------------------------------------------------------
