@@ -111,7 +111,7 @@ def test_runs_stacked_from_their_headers_are_xarrays_concatenation(tmp_path):
     lazy = open_stacked(files, chunk=False)
     eager = xr.concat([xr.load_dataset(p) for p in files], dim="run", **_STACK)
     assert lazy.identical(eager.load()) and lazy.sizes["time"] == 51
-    long = int(np.isfinite(eager.chassis_y[:, -1]).argmax())   # the 0.05 s run
+    long = int(np.argmax(np.isfinite(eager.chassis_y.values[:, -1])))   # the 0.05 s run
     os.remove(files[1 - long])   # only the longer run is read below
     assert np.isfinite(lazy.chassis_y.isel(run=long).values).all()
     with pytest.raises(FileNotFoundError):
