@@ -128,3 +128,28 @@ def test_runs_that_do_not_line_up_are_left_to_xarray(tmp_path):
     ds = tb.open_study_dataset(tmp_path / "a")
     assert ds.sizes["run"] == 2 and ds.sizes["time"] == 41   # 0..0.03 by 1 ms, then 0.032..0.05 by 2 ms
     ds.close()
+
+
+def test_the_coordinator_checks_a_runs_file_by_its_signature_and_size(tmp_path):
+    """A completed run's timeseries.nc is taken when it starts as netCDF-4 and has the size the
+    worker reported; the same size of other bytes is not; a record without the size (a worker
+    of an earlier version) has its file opened."""
+    from trackbench.study import executors
+
+    (tmp_path / "c.toml").write_text('[study]\nname = "c"\n[scenario]\nduration = 0.01\n'
+                                     "record = { enabled = false }\n")
+    s = load_study(tmp_path / "c.toml", output=tmp_path / "c")
+    s.output.mkdir()
+    store.write_json(s.output / "runs.json", {})
+    task = {"run_id": s.runs[0].run_id, "output": str(s.output), "scenario": s.runs[0].scenario,
+            "meta": {}, "attempt_id": "a1"}
+    rec = executors.execute_run(task)
+    nc = store.run_dir(s.output, task["run_id"]) / "timeseries.nc"
+    assert rec["timeseries_bytes"] == nc.stat().st_size and runner.confirm(task, rec) is rec
+    old = {k: v for k, v in rec.items() if k != "timeseries_bytes"}
+    assert runner.confirm(task, old) is old
+    good = nc.read_bytes()
+    nc.write_bytes(b"\0" * len(good))
+    got = runner.confirm(task, rec)
+    assert got["status"] == "failed" and "not a netCDF-4 (HDF5) file" in got["status_message"]
+    assert not nc.exists()

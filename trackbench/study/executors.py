@@ -207,7 +207,8 @@ def _write(ds, rdir, task, rec):
     )
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-               timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording)
+               timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording,
+               timeseries_bytes=(rdir / "timeseries.nc").stat().st_size)   # the coordinator's check
     if err:
         rec["recording_error"] = err
 
