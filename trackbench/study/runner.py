@@ -154,7 +154,6 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
     ValueError before anything starts on bad input, StudyLocked when another process works on
     the same folder. ``storage`` ("full" or "compact") overrides the study's [study] storage."""
     t0 = time.perf_counter()
-    from . import summary  # noqa: F401  (pandas, for the summary at the end: loaded while the workers start)
     study = _prepare(path, workers, executor, scheduler, output, storage)
     check_output(study)
     out = Outcome(study=study)
@@ -164,6 +163,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
         store.write_text(study.output / "study.toml", resolved_toml(study))
         store.write_json(study.output / "runs.json", manifest(study))
         waves = _Waves(study, out, force, (executor, workers, scheduler), quiet)
+        tables = _import_tables()
         try:
             if study.search is None:
                 waves(study.runs)
@@ -174,6 +174,7 @@ def run_study(path, workers=2, executor="local", scheduler=None, force=False, ou
             waves.close()
             warming.forget()
             store.clean_tmp(study.output)  # what killed workers left half-written
+            tables()
             _summarise(study, out)
             out.others = len(other_runs(study))
     out.elapsed = time.perf_counter() - t0
@@ -235,6 +236,24 @@ class _Waves:
         finally:
             if self.progress is not None:
                 self.progress.close()
+
+
+def _import_tables():
+    """Import pandas and pyarrow (the summary's frame and its files, 0.3-0.5 s) in a thread
+    while the workers start and run, instead of after the last run; returns a function that
+    waits for it. This process imports neither elsewhere until then (no two threads race for
+    the same modules); a failed import is left for the summary to report."""
+    import threading
+
+    def body():
+        for name in ("pandas", "pyarrow"):
+            try:
+                __import__(name)
+            except Exception:  # noqa: BLE001  (pyarrow is optional; pandas fails again where used)
+                pass
+    th = threading.Thread(target=body, name="trackbench-import-tables", daemon=True)
+    th.start()
+    return th.join
 
 
 def _prepare(path, workers, executor, scheduler, output, storage):
