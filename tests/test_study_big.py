@@ -83,11 +83,12 @@ def test_the_coordinator_holds_no_run_arrays(tmp_path, monkeypatch):
 
     monkeypatch.setattr(runner, "confirm", spy)
     gc.collect()
-    before = {id(o) for o in gc.get_objects() if isinstance(o, np.ndarray) and o.nbytes > 16_000}
+    # held here, so that no new array can take an old one's id; type(): a dead weak proxy raises
+    before = {id(o): o for o in gc.get_objects() if type(o) is np.ndarray and o.nbytes > 16_000}
     out = run_study(tmp_path / "s.toml", workers=2, output=tmp_path / "out", quiet=True)
     gc.collect()
     big = [o for o in gc.get_objects()
-           if isinstance(o, np.ndarray) and o.nbytes > 16_000 and id(o) not in before]
+           if type(o) is np.ndarray and o.nbytes > 16_000 and id(o) not in before]
     assert out.problem() is None and len(seen) == 4
     # a run's chassis_y alone is 201 x 8 bytes; pin_x 201 x 31 x 8 = 50 kB
     assert max(seen) < 16_000 and not big

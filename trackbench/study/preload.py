@@ -91,7 +91,7 @@ def _kinds():
         yield sc, spec.get("flag")
 
 
-WAIT = 600.0   # s: the longest a server waits for the command to say what to warm
+WAIT = 120.0   # s: the longest a server waits for the command to say what to warm
 
 
 def _announced(path):

@@ -63,10 +63,19 @@ def announce(scenarios):
     os.replace(tmp, path)   # whole or not at all: the server reads it as soon as it appears
 
 
+def _told_later():
+    """Was the server of this process started with LATER (it waits for warm_file())?"""
+    return "file" in json.loads(os.environ.get(WARM) or "{}")
+
+
 def forget():
-    """Remove this command's files of the protocol (at its end)."""
+    """Remove this command's files of the protocol (at its end). A server started again later
+    in this process (a long-lived one: a notebook, tests) then warms the paper's model instead
+    of waiting for a file no one will write."""
     for p in (compile_flag(), warm_file()):
         p.unlink(missing_ok=True)
+    if _told_later():
+        os.environ.pop(WARM, None)
 
 
 PRELOAD = "trackbench.study.preload"
@@ -90,7 +99,7 @@ def start_workers(executor="local", scheduler=None, warm=None):
     in compile_flag()) before it forks a worker, or LATER (the command says which
     through warming.announce, once it has read the study); default: the paper's. Once the
     server runs, a list is announced to it (when it waits for one)."""
-    if warm is not None and _server_pid() is not None and warm != LATER:
+    if warm is not None and warm != LATER and _told_later():
         announce(warm)
     elif warm is not None:
         os.environ[WARM] = json.dumps(spec(warm))
@@ -112,8 +121,7 @@ def start_workers(executor="local", scheduler=None, warm=None):
 
 
 def _server_pid():
-    """The pid of the fork server this process started, or None. Not reaped here: multiprocessing
-    finds a stopped server itself (ensure_running starts another)."""
+    """The pid of the fork server this process started, or None."""
     from multiprocessing import forkserver
     return getattr(forkserver._forkserver, "_forkserver_pid", None)
 
@@ -121,11 +129,16 @@ def _server_pid():
 def stop_server():
     """Stop the fork server this process started (a command with nothing to run, or bad input
     found after it started): it would otherwise finish its preload, a second of a core, for no
-    worker."""
+    worker. Waited for, and multiprocessing told (its ForkServer._stop, which its own tests
+    use): a pool started later in this process then starts a new server instead of connecting
+    to the dying one."""
     import signal
+    from multiprocessing import forkserver
     pid = _server_pid()
     if pid is not None:
         try:
             os.kill(pid, signal.SIGTERM)
-        except ProcessLookupError:
+            forkserver._forkserver._stop()
+        except (ProcessLookupError, ChildProcessError):
             pass
+    forget()
