@@ -1,6 +1,6 @@
-"""Study benchmark: whole commands, per-run overhead, storage, dask, a 200-run study.
+"""Study benchmark: whole commands, per-run overhead, storage, dask, a 1,000-run study.
 
-    python benchmarks/bench_study.py [--repeat 5] [--parts sweep,storage,dask,large]
+    python benchmarks/bench_study.py [--repeat 5] [--parts fixed,sweep,long,storage,dask,big]
                                      [--reference RESULTS_DIR]
 
 Every figure is a whole `trackbench study run` command in a fresh process on a fresh results
@@ -16,8 +16,11 @@ storage  the same sweep with --storage compact: the largest run folder full / co
 --reference  compare the sweep's summary.csv numbers and every array of every timeseries.nc
          bit for bit with a results folder of the same sweep written by another version
 dask     the sweep on a dask LocalCluster of 2 worker processes against the process pool
-large    200 runs of 0.5 s (speeds 5.00 .. 14.95 m/s, recordings off): runs per second, the
-         command's memory as runs accumulate, write_summary time for 25 .. 200 runs
+fixed    what every command pays: a one-run study of 0.01 s, and `trackbench run --duration 0.01`
+long     benchmarks/long_runs.toml (16 runs of ~2 s solve) with 1 and 2 workers: speed-up, and
+         the per-run work outside the solve from run.json
+big      1,000 runs of 0.01 s (recordings off): the command's memory as runs accumulate, then
+         `study status`, write_summary and open_study_dataset on the folder
 """
 
 import argparse
@@ -257,13 +260,71 @@ def part_dask(cwd, repeat):
     )
 
 
-LARGE = """[study]
-name = "large"
+ONE = '[study]\nname = "one"\n[scenario]\nduration = 0.01\n'
+
+
+def timed(cwd, args):
+    """Wall time (s) of one whole trackbench command in ``cwd``, its output thrown away."""
+    t = time.perf_counter()
+    r = subprocess.run(CLI + args, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        raise SystemExit(f"trackbench {' '.join(args)} failed: {r.stderr[-2000:]}")
+    return time.perf_counter() - t
+
+
+def part_fixed(cwd, repeat):
+    """What every command pays: a one-run study of 0.01 s and `trackbench run --duration 0.01`,
+    whole commands (fresh process, fresh results), alternated."""
+    (cwd / "one.toml").write_text(ONE)
+
+    def study():
+        shutil.rmtree(cwd / "results" / "one", ignore_errors=True)
+        return {"wall": timed(cwd, ["study", "run", "one.toml"])}
+
+    def run():
+        return {"wall": timed(cwd, ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"])}
+
+    res = alternate(repeat, {"study": study, "run": run})
+    print(f"\n== fixed cost, whole command, {repeat} alternating rounds (median [min, max])")
+    for name, label in (("study", "study run of one 0.01 s run"), ("run", "trackbench run --duration 0.01")):
+        w = [r["wall"] for r in res[name]]
+        print(f"{label:32s} {statistics.median(w):.2f} s [{min(w):.2f}, {max(w):.2f}] (target <= 1 s)")
+
+
+def long_case(cwd, workers):
+    def fn():
+        wall = command(cwd, "long_runs.toml", "-w", str(workers))
+        med_o, worst, solve = overhead(records(cwd / "results" / "long_runs"))
+        return {"wall": wall, "solve": solve, "med": med_o, "max": worst}
+
+    return fn
+
+
+def part_long(cwd, repeat):
+    """benchmarks/long_runs.toml (16 runs of ~2 s solve): 1 against 2 workers, whole commands
+    alternated, and the per-run work outside the solve from run.json."""
+    shutil.copy(REPO / "benchmarks" / "long_runs.toml", cwd / "long_runs.toml")
+    res = alternate(repeat, {1: long_case(cwd, 1), 2: long_case(cwd, 2)})
+    ratios = [a["wall"] / b["wall"] for a, b in zip(res[1], res[2])]
+    print(f"\n== long_runs (16 runs of ~2 s), whole command, {repeat} alternating pairs")
+    for w in (1, 2):
+        walls = [r["wall"] for r in res[w]]
+        print(f"{w} worker{'s' if w > 1 else ' '}: {statistics.median(walls):.1f} s [{min(walls):.1f}, "
+              f"{max(walls):.1f}]; solve total {med(res[w], 'solve'):.1f} s; (wall - solve) / solve per run: "
+              f"median {100 * med(res[w], 'med'):.1f} %, largest {100 * max(r['max'] for r in res[w]):.0f} %"
+              " (target: median <= 10 %)")
+    print(f"speed-up 2 vs 1 workers: median {statistics.median(ratios):.2f}x [{min(ratios):.2f}, "
+          f"{max(ratios):.2f}] (target >= 1.85x)")
+
+
+BIG = """[study]
+name = "big"
 [scenario]
-duration = 0.5
+duration = 0.01
+output_interval = 1e-3
 record = {{ enabled = false }}
 [grid]
-speed = {{ start = 5.0, stop = {stop}, step = 0.05 }}
+speed = {{ start = 5.0, stop = {stop}, step = 0.01 }}
 """
 
 
@@ -282,67 +343,58 @@ def sample_memory(proc, out, every=0.2):
     return rows
 
 
-def part_large(cwd, n=200):
-    (cwd / "large.toml").write_text(LARGE.format(stop=round(5.0 + 0.05 * (n - 1), 2)))
-    out = cwd / "results" / "large"
+def part_big(cwd, n=1000, repeat=5):
+    """A study of ``n`` runs of 0.01 s (recordings off, 2 workers): the command's memory as runs
+    accumulate, then `study status`, write_summary and open_study_dataset on its folder."""
+    (cwd / "big.toml").write_text(BIG.format(stop=round(5.0 + 0.01 * (n - 0.5), 3)))
+    out = cwd / "results" / "big"
     shutil.rmtree(out, ignore_errors=True)
     t = time.perf_counter()
-    proc = subprocess.Popen(
-        CLI + ["study", "run", "large.toml"], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
-    )
+    proc = subprocess.Popen(CLI + ["study", "run", "big.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
     rows = sample_memory(proc, out)
     wall = time.perf_counter() - t
     recs = records(out)
-    span = max(r["finished_unix"] for r in recs) - min(r["started_unix"] for r in recs)
-    med_o, max_o, solve = overhead(recs)
-    print(
-        f"\n== {n}-run study (0.5 s runs, 2 workers, recordings off): exit {proc.returncode}, "
-        f"{len(recs)} runs"
-    )
-    print(
-        f"whole command {wall:.1f} s: {n / wall:.2f} runs/s; first run start to last run end {span:.1f} s: "
-        f"{n / span:.2f} runs/s; solve total {solve:.1f} s (sum / (2 x wall) = {solve / (2 * wall):.2f}); "
-        f"per-run overhead median {100 * med_o:.0f} %"
-    )
-    marks = [
-        rows[min(range(len(rows)), key=lambda i: abs(rows[i][1] - k))] for k in (n // 10, n // 2, n * 9 // 10)
-    ]
-    print(
-        "memory of the command (main process) as runs accumulate: "
-        + ", ".join(f"{r[1]} runs {r[2]:.0f} MB" for r in marks)
-        + f"; peak {max(r[2] for r in rows):.0f} MB"
-    )
-    part_summary_time(out, n)
+    print(f"\n== {n}-run study (0.01 s runs, 2 workers, recordings off): exit {proc.returncode}, "
+          f"{len(recs)} runs, whole command {wall:.1f} s ({n / wall:.0f} runs/s)")
+    marks = [rows[min(range(len(rows)), key=lambda i: abs(rows[i][1] - k))]
+             for k in (n // 10, n // 2, n * 9 // 10)]
+    print("memory of the command (coordinator) as runs accumulate: "
+          + ", ".join(f"{r[1]} runs {r[2]:.0f} MB" for r in marks)
+          + f"; peak {max(r[2] for r in rows):.0f} MB")
+    status = [timed(cwd, ["study", "status", str(out)]) for _ in range(repeat)]
+    print(f"study status (whole command): median {statistics.median(status):.2f} s [{min(status):.2f}, "
+          f"{max(status):.2f}] (target < 1 s)")
+    part_reading(out, repeat)
 
 
-def part_summary_time(out, n):
-    """write_summary (summary.csv + .parquet from every run.json) for the first n/8 .. n runs,
-    best of 5, and the straight line a + b x runs through them."""
+def part_reading(out, repeat):
+    """write_summary and open_study_dataset on a study folder, in this process, median of ``repeat``."""
+    import trackbench as tb
     from trackbench.study.summary import _study_of, write_summary
 
-    study = _study_of(out)
-    runs, ks, best = study.runs, [n // 8, n // 4, n // 2, n], []
-    for k in ks:
-        study.runs = runs[:k]
-        times = []
-        for _ in range(5):
-            t = time.perf_counter()
-            write_summary(study)
-            times.append(time.perf_counter() - t)
-        best.append(min(times))
-    b, a = np.polyfit(ks, best, 1)
-    worst = max(abs(a + b * k - t) / t for k, t in zip(ks, best))
-    print(
-        "write_summary, best of 5: "
-        + "; ".join(f"{k} runs {1e3 * t:.0f} ms" for k, t in zip(ks, best))
-        + f"; line {1e3 * a:.0f} ms + {1e3 * b:.2f} ms per run (largest deviation {100 * worst:.0f} %)"
-    )
+    study, summary, opened, first = _study_of(out), [], [], []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        write_summary(study)
+        summary.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        ds = tb.open_study_dataset(out)
+        opened.append(time.perf_counter() - t)
+        t = time.perf_counter()
+        ds.chassis_y.isel(run=0).load()
+        first.append(time.perf_counter() - t)
+        ds.close()
+    print(f"write_summary (summary.csv + .parquet): median {statistics.median(summary):.2f} s "
+          f"(target < 2 s); open_study_dataset: {statistics.median(opened):.2f} s, lazy (chunks "
+          f"{ds.chassis_y.chunks is not None}); one run's chassis_y read: "
+          f"{1e3 * statistics.median(first):.0f} ms")
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--repeat", type=int, default=5, help="alternating repeats of each comparison")
-    ap.add_argument("--parts", default="sweep,storage,dask,large")
+    ap.add_argument("--parts", default="fixed,sweep,long,storage,dask,big")
     ap.add_argument(
         "--reference", help="results folder of the speed sweep from another version (bit for bit)"
     )
@@ -368,8 +420,12 @@ def main():
             part_reference(cwd, args.reference)
         if "dask" in parts:
             part_dask(cwd, args.repeat)
-        if "large" in parts:
-            part_large(cwd)
+        if "fixed" in parts:
+            part_fixed(cwd, args.repeat)
+        if "long" in parts:
+            part_long(cwd, args.repeat)
+        if "big" in parts:
+            part_big(cwd, repeat=args.repeat)
     seen = [f"{x:.2f}" for x in QUIET["seen"] if x is not None]
     print(
         f"load average after: {os.getloadavg()[0]:.2f}"

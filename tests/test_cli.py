@@ -64,3 +64,34 @@ def test_run_that_cannot_start_says_why_in_one_line(tmp_path):
         and "track.width" in lines[0]
     )
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_validating_a_study_of_the_paper_layout_loads_no_compiler():
+    """The coordinator of `study run` and `study status` validate every run: with the paper's
+    layout that needs no numba (the workers' server loads it meanwhile)."""
+    code = (
+        "import sys; from trackbench.study.spec import load_study; s = load_study(sys.argv[1]); "
+        "print(len(s.runs), sorted(m for m in %r if m in sys.modules))" % (HEAVY,)
+    )
+    out = subprocess.run([sys.executable, "-c", code, "studies/speed_sweep.toml"], capture_output=True,
+                         text=True, check=True)
+    assert out.stdout.split() == ["15", "[]"]
+
+
+def test_the_checks_track_path_is_the_models():
+    """The geometry checks measure the taut path with numpy's cos and sin; the model lays its
+    pins along the same path with the compiled ones: the same wheels, the same length."""
+    import numpy as np
+
+    import trackbench as tb
+    from trackbench.model.vehicle.parameters import wheel_centres_body
+    from trackbench.model.vehicle.track_path import initial_track
+    from trackbench.scenario.check_vehicle import _taut_length, wheel_centres_for_checks
+
+    sc = tb.Scenario.paper()
+    v, tr = sc["vehicle"], sc["track"]
+    wc = wheel_centres_body(v)
+    assert np.allclose(wheel_centres_for_checks(v), wc, rtol=0, atol=1e-15)
+    ends = np.array([v["front_track_end"], v["rear_track_end"]], float)
+    rho = v["wheel_radius"] + tr["pad_wheel"]
+    assert abs(_taut_length(ends, wc, rho) - initial_track(ends, wc, rho, tr["n_links"])[1]) < 1e-12

@@ -450,3 +450,50 @@ def test_workers_are_forks_of_a_single_threaded_preloaded_server():
     assert all(
         g["threads_at_fork"] == 1 and g["loop_signatures"] >= 1 and g["pid"] != os.getpid() for g in got
     )
+
+
+WARM_LATER = """
+import json, sys
+from trackbench.study import executors
+from trackbench.study.preload import facts
+from trackbench.study.warming import LATER, announce, forget
+executors.start_workers(warm=LATER)
+announce(json.loads(sys.argv[1]))
+pool = executors._new_pool(1)
+print(json.dumps(pool.submit(facts).result(timeout=300)))
+pool.shutdown()
+forget()
+"""
+
+
+@pytest.mark.parametrize("announced", [[], [{"speed": 5.0}]])
+def test_the_server_warms_what_the_command_announces_after_it_started(announced):
+    """`study run` starts the workers' server before it reads the study file and announces the
+    kinds of model later: the server waits for that, and loads those kinds only (nothing for
+    []); its workers never load dask's arrays."""
+    out = subprocess.run([sys.executable, "-c", WARM_LATER, json.dumps(announced)], capture_output=True,
+                         text=True, check=True, timeout=600)
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    assert (got["loop_signatures"] >= 1) == bool(announced)
+    assert got["threads_at_fork"] == 1 and not got["dask_arrays"]
+
+
+STOPPED = """
+import json
+from trackbench.study import executors
+from trackbench.study.preload import facts
+from trackbench.study.warming import LATER, stop_server
+executors.start_workers(warm=LATER)
+stop_server()   # bad input found after the start: nothing will be announced
+pool = executors._new_pool(1)
+print(json.dumps(pool.submit(facts).result(timeout=60)))
+pool.shutdown()
+"""
+
+
+def test_a_server_started_again_after_a_stop_does_not_wait_for_an_announcement():
+    """A long-lived process (a notebook, tests) whose command stopped the server before
+    announcing anything gets a server that warms the paper's model when it starts again."""
+    out = subprocess.run([sys.executable, "-c", STOPPED], capture_output=True, text=True, check=True,
+                         timeout=100)
+    assert json.loads(out.stdout.strip().splitlines()[-1])["loop_signatures"] >= 1

@@ -24,7 +24,7 @@ from pathlib import Path
 from ..quantities import run_summary
 from ..storage import frame_step, recording_steps
 from . import store
-from .warming import WARM, compile_flag
+from .warming import PRELOAD, _context, start_workers, stop_server  # noqa: F401  (the pool's server)
 
 
 def _now():
@@ -208,7 +208,8 @@ def _write(ds, rdir, task, rec):
     )
     rec.update(status=a["status"], status_message=msg, t_final=a["t_final"], steps=a["steps"],
                rejected_steps=a["rejected_steps"], solve_time=a["solve_time"], sim_wall_time=a["wall_time"],
-               timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording)
+               timeseries="timeseries.nc", storage=storage, results=run_summary(ds), recording=recording,
+               timeseries_bytes=(rdir / "timeseries.nc").stat().st_size)   # the coordinator's check
     if err:
         rec["recording_error"] = err
 
@@ -264,45 +265,6 @@ def _attempt(task, number):
     """The task for try ``number``: a fresh attempt_id lets the coordinator tell this try's
     run.json from an older one (a --force rerun, an earlier try)."""
     return {**task, "attempt": number, "attempt_id": uuid.uuid4().hex}
-
-
-PRELOAD = "trackbench.study.preload"
-
-
-def _context():
-    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
-    where the platform has no fork server."""
-    import multiprocessing
-    if "forkserver" not in multiprocessing.get_all_start_methods():
-        return multiprocessing.get_context("spawn")
-    ctx = multiprocessing.get_context("forkserver")
-    ctx.set_forkserver_preload([PRELOAD])
-    return ctx
-
-
-def start_workers(executor="local", scheduler=None, warm=None):
-    """Start the fork server now (it loads in its own process while the command does its own
-    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
-    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
-    in compile_flag()) before it forks a worker; default: the paper's."""
-    if warm:
-        import json
-        os.environ[WARM] = json.dumps({"scenarios": warm, "flag": str(compile_flag())})
-    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
-    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
-    # pyarrow: the fork server and the workers inherit this, and so the server has a single
-    # thread when it forks (preload.py)
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
-    if scheduler:
-        return
-    ctx = _context()
-    if ctx.get_start_method() == "forkserver":
-        if executor == "dask":   # its nannies start worker processes from the same server
-            ctx.set_forkserver_preload(["distributed", PRELOAD])
-        from multiprocessing import forkserver
-        forkserver.ensure_running()
 
 
 def _new_pool(workers):

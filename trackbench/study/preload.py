@@ -1,9 +1,11 @@
 """What the study workers' fork server loads once, before it forks any worker.
 
 `study run` starts a fork server (multiprocessing's "forkserver": a fresh Python process
-started from the command, not a fork of it) with this module as its preload. Importing it
-imports the package, numpy, numba, xarray, pandas and netCDF4, loads the compiled kernels
-from the numba cache by running a 1 ms simulation, and writes one small netCDF file (HDF5's
+started from the command, not a fork of it) with this module as its preload, first thing,
+before it reads the study file. Importing it imports the package, numpy, numba, xarray,
+pandas and netCDF4 (while the command validates and expands the study), then loads the
+compiled kernels of the kinds of model the command announces (warming.py) from the numba
+cache by running a 1 ms simulation of each, and writes one small netCDF file (HDF5's
 set-up and the zstd filter plugin) in a temporary folder. Each worker is then a fork of this
 process: it starts with all of that done instead of redoing it. Should the command be gone
 before the preload ends (Ctrl-C), the server stops instead of loading for nobody.
@@ -46,6 +48,8 @@ def warm():
     import tempfile
     from pathlib import Path
 
+    from trackbench.startup import without_dask_arrays
+    without_dask_arrays()   # the pool's workers hold numpy arrays only
     import netCDF4  # noqa: F401
     import pandas  # noqa: F401  (the summary of a run's results)
     import xarray  # noqa: F401
@@ -74,7 +78,7 @@ def _kinds():
     from trackbench.study.warming import WARM
     spec = json.loads(os.environ.get(WARM) or "{}")
     short = {"duration": 1e-3, "output_interval": 1e-3}
-    kinds = spec.get("scenarios") or [None]
+    kinds = _announced(spec["file"]) if spec.get("file") else spec.get("scenarios") or [None]
     for d in kinds:
         try:
             sc = (
@@ -85,6 +89,26 @@ def _kinds():
         except Exception:  # noqa: BLE001  (the real run reports it)
             continue
         yield sc, spec.get("flag")
+
+
+WAIT = 120.0   # s: the longest a server waits for the command to say what to warm
+
+
+def _announced(path):
+    """The scenarios the command announces in ``path`` once it has read the study (warming.py):
+    the server waits for them (its imports are done by then); [] for nothing; the paper's
+    when the command says nothing within WAIT seconds."""
+    import json
+    import time
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < WAIT:
+        _orphaned()
+        try:
+            with open(path) as f:
+                return json.load(f)["scenarios"]
+        except (OSError, ValueError, KeyError):
+            time.sleep(0.005)
+    return [None]
 
 
 def _load(kind):
@@ -116,13 +140,17 @@ def warm_recording():
 
 def facts():
     """What a worker inherited (for tests and diagnosis): its pid, the fork server's thread
-    count at the end of the preload, and how many compiled signatures the time loop has."""
+    count at the end of the preload, how many compiled signatures the time loop has, and
+    whether dask's arrays are loaded."""
+    import sys
+
     from trackbench.solvers.rk.rk_loop import integrate
 
     return {
         "pid": os.getpid(),
         "threads_at_fork": THREADS_AT_FORK,
         "loop_signatures": len(integrate.signatures),
+        "dask_arrays": sys.modules.get("dask.array") is not None,
     }
 
 

@@ -1,11 +1,12 @@
-"""Reading a study: the pandas summary, replicate statistics, open_study / open_study_dataset."""
+"""Reading a study: the pandas summary, replicate statistics, open_study / open_study_dataset.
+pandas loads in the functions that build frames: finding a study's folder (`study status`)
+does without it."""
 
 import importlib.util
 import os
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from .. import quantities as Q
 from . import store
@@ -39,6 +40,7 @@ def peak_columns(study):
 
 def summary_frame(study):
     """One row per run of the study (pending when it has not run), from the runs' run.json."""
+    import pandas as pd
     wheels, features = Q.shape_of(r.scenario for r in study.runs)
     results = Q.summary_columns(wheels, features=features)
     rows = []
@@ -64,6 +66,7 @@ def summary_frame(study):
 def replicate_frame(study, df):
     """One row per variant: median, min, max and relative spread of every peak over its completed
     replicates; ``sensitive`` lists the quantities whose spread exceeds 5 %."""
+    import pandas as pd
     params = [p for p in study.param_names if p != "seed"]
     rows = []
     for v, g in df.groupby("variant", sort=True):
@@ -97,6 +100,7 @@ def write_summary(study):
 
 def format_table(df, rep=None, params=()):
     """A screen-sized table: the SCREEN quantities in their display units (forces in kN)."""
+    import pandas as pd
     show = pd.DataFrame({"run": df.run_id.str[:8], "status": df.status})
     for p in params:
         show[p] = df[p]
@@ -206,18 +210,24 @@ def _have_dask():
 
 
 def _stacked(paths, lazy):
-    """The runs' files along ``run``: lazily with dask (xarray.open_mfdataset) where it is
-    installed (the `dask` extra), else read into memory (each file closed after reading)."""
+    """The runs' files along ``run``, lazily from their headers (stacked.py: one dask chunk per
+    run where dask is installed); where they do not line up, with xarray.open_mfdataset where
+    dask is installed (the `dask` extra), else read into memory (each file closed after reading)."""
     import xarray as xr
+
+    from .stacked import open_stacked
+    ds = open_stacked(paths, chunk=lazy)
+    if ds is not None:
+        return ds
     if lazy:
         return xr.open_mfdataset(paths, combine="nested", concat_dim="run", parallel=False, **_STACK)
     return xr.concat([xr.load_dataset(p) for p in paths], dim="run", **_STACK)
 
 
 def open_study_dataset(path, status=("completed", "failed")):
-    """All runs' time histories stacked along a ``run`` dimension, opened lazily (dask) with
-    xarray.open_mfdataset where dask is installed, else read into memory; runs of different
-    durations are aligned on time (NaN-padded). The study's parameters and each run's status
+    """All runs' time histories stacked along a ``run`` dimension, opened lazily: a run's file
+    is read when a selection needs it (one dask chunk per run where dask is installed); runs of
+    different durations are aligned on time (NaN-padded). The study's parameters and each run's status
     become coordinates along ``run``."""
     study = _study_of(path)
     df = summary_frame(study)

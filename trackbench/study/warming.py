@@ -1,12 +1,20 @@
-"""What the command tells the workers' fork server to warm (preload.py), and where the
-server says that it compiles: the one protocol both sides share, light enough for the
-command to import (no numba)."""
+"""The workers' fork server from the command's side: its start and stop, what the command
+tells it to warm (preload.py) and where the server says that it compiles: the one protocol
+both sides share, light enough for the command to import (no numba).
 
+The command starts the server before it reads the study file (the server's imports, about
+a second, then overlap the validation and the expansion of the runs), so the server cannot
+be told on its command line which kinds of model the runs need: it is told LATER, through
+warm_file(), which the command writes (announce) once it knows the runs, and which the
+server waits for after its imports."""
+
+import json
 import os
 from pathlib import Path
 
-WARM = "TRACKBENCH_WARM"    # what the fork server's preload warms: JSON {"scenarios": [...], "flag": path}
+WARM = "TRACKBENCH_WARM"    # the server's spec (JSON): {"scenarios": [...]} or {"file": path}; "flag"
 MAX_WARM = 4
+LATER = "later"             # start_workers(warm=LATER): the kinds come through warm_file()
 
 
 def warm_kinds(scenarios):
@@ -19,7 +27,118 @@ def warm_kinds(scenarios):
     return list(kinds.values())[:MAX_WARM]
 
 
+def _tmp(kind):
+    import tempfile
+    return Path(tempfile.gettempdir()) / f"trackbench-{kind}-{os.getpid()}.json"
+
+
 def compile_flag():
     """The file where this command's fork server says that it compiles (the progress shows it)."""
-    import tempfile
-    return Path(tempfile.gettempdir()) / f"trackbench-compiling-{os.getpid()}.json"
+    return _tmp("compiling")
+
+
+def warm_file():
+    """The file through which this command tells a server started with LATER what to warm."""
+    return _tmp("warm")
+
+
+def spec(warm):
+    """The server's WARM spec for start_workers(warm=...): a list of scenario dicts, or LATER."""
+    if warm == LATER:
+        warm_file().unlink(missing_ok=True)   # a file of an earlier process of the same pid
+        return {"file": str(warm_file()), "flag": str(compile_flag())}
+    return {"scenarios": warm, "flag": str(compile_flag())}
+
+
+def announce(scenarios):
+    """Tell the server what to warm (a list of scenario dicts; [] for nothing) when it waits for
+    it (started with LATER); a no-op otherwise, or once said."""
+    said = json.loads(os.environ.get(WARM) or "{}")
+    path = said.get("file")
+    if not path or os.path.exists(path):
+        return
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "w") as f:
+        json.dump({"scenarios": scenarios}, f)
+    os.replace(tmp, path)   # whole or not at all: the server reads it as soon as it appears
+
+
+def _told_later():
+    """Was the server of this process started with LATER (it waits for warm_file())?"""
+    return "file" in json.loads(os.environ.get(WARM) or "{}")
+
+
+def forget():
+    """Remove this command's files of the protocol (at its end). A server started again later
+    in this process (a long-lived one: a notebook, tests) then warms the paper's model instead
+    of waiting for a file no one will write."""
+    for p in (compile_flag(), warm_file()):
+        p.unlink(missing_ok=True)
+    if _told_later():
+        os.environ.pop(WARM, None)
+
+
+PRELOAD = "trackbench.study.preload"
+
+
+def _context():
+    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
+    where the platform has no fork server."""
+    import multiprocessing
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload([PRELOAD])
+    return ctx
+
+
+def start_workers(executor="local", scheduler=None, warm=None):
+    """Start the fork server now (it loads in its own process while the command does its own
+    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
+    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
+    in compile_flag()) before it forks a worker, or LATER (the command says which
+    through warming.announce, once it has read the study); default: the paper's. Once the
+    server runs, a list is announced to it (when it waits for one)."""
+    if warm is not None and warm != LATER and _told_later():
+        announce(warm)
+    elif warm is not None:
+        os.environ[WARM] = json.dumps(spec(warm))
+    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
+    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
+    # pyarrow: the fork server and the workers inherit this, and so the server has a single
+    # thread when it forks (preload.py)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
+    if scheduler:
+        return
+    ctx = _context()
+    if ctx.get_start_method() == "forkserver":
+        if executor == "dask":   # its nannies start worker processes from the same server
+            ctx.set_forkserver_preload(["distributed", PRELOAD])
+        from multiprocessing import forkserver
+        forkserver.ensure_running()
+
+
+def _server_pid():
+    """The pid of the fork server this process started, or None."""
+    from multiprocessing import forkserver
+    return getattr(forkserver._forkserver, "_forkserver_pid", None)
+
+
+def stop_server():
+    """Stop the fork server this process started (a command with nothing to run, or bad input
+    found after it started): it would otherwise finish its preload, a second of a core, for no
+    worker. Waited for, and multiprocessing told (its ForkServer._stop, which its own tests
+    use): a pool started later in this process then starts a new server instead of connecting
+    to the dying one."""
+    import signal
+    from multiprocessing import forkserver
+    pid = _server_pid()
+    if pid is not None:
+        try:
+            os.kill(pid, signal.SIGTERM)
+            forkserver._forkserver._stop()
+        except (ProcessLookupError, ChildProcessError):
+            pass
+    forget()
