@@ -114,11 +114,12 @@ def blueprint(ds, follow=False):
     top = float(np.nanmax(ds.variables["chassis_y"].values)) + G.HULL_TOP + 0.5
     bottom = float(np.min(ground[:, 1])) - 0.5
     window = G.follow_window(ds) if follow else None
+    # following: the root as origin, so that /world's own transform applies
+    where = {"origin": "/", "contents": [E_WORLD + "/**"]} if window else {"origin": E_WORLD}
     side = rrb.Spatial2DView(
-        origin="/" if window else E_WORLD,   # the root: /world's own transform then applies
-        contents=[E_WORLD + "/**"] if window else None,
         name="side view (x forward; up is up)" + (", following the chassis" if window else ""),
         visual_bounds=rrb.VisualBounds2D(x_range=list(window or (x0, x1)), y_range=[-top, -bottom]),
+        **where,
     )
     plots = rrb.Vertical(
         rrb.TimeSeriesView(origin=E_WHEEL_FY, name="vertical wheel-track force (N)"),
