@@ -114,6 +114,37 @@ def test_failed_and_pending_runs_end_a_point_and_the_waves_go_on_without_it():
     assert ev.calls == [25] + [2] * S.bisection_rounds(sp)
 
 
+def test_a_failed_run_with_a_maximum_already_over_the_limit_counts_as_over(monkeypatch):
+    """A maximum can only grow: a run that failed after passing the limit is over it (the
+    shipped obstacle study's 0.3 m step throws the idler off its guide at 1.15 s, after the
+    seat's 2.8 g); under the limit, or a mean, a failed run stays unknown."""
+    from types import SimpleNamespace
+
+    from trackbench.study import limits
+    recs = {"over": {"status": "failed", "results": {"peak_q": 3.0, "mean_q": 3.0}},
+            "under": {"status": "failed", "results": {"peak_q": 1.0}}}
+    monkeypatch.setattr(limits.store, "read_run", lambda output, run_id: recs[run_id])
+    study = SimpleNamespace(output=None, search=spec(quantity="peak_q", limit=2.0))
+    assert limits.quantity_of(study, SimpleNamespace(run_id="over")) == 3.0
+    assert limits.quantity_of(study, SimpleNamespace(run_id="under")) is None
+    study.search = spec(quantity="mean_q", limit=2.0)
+    assert limits.quantity_of(study, SimpleNamespace(run_id="over")) is None
+
+
+def test_a_search_study_with_only_decided_failures_exits_cleanly():
+    """The run that failed over the limit is the search's answer: no problem line, no nonzero
+    exit; a failure under the limit (unknown) still is one."""
+    from types import SimpleNamespace
+
+    from trackbench.study.runner import Outcome
+    study = SimpleNamespace(search=spec(quantity="peak_q", limit=2.0), runs=[None] * 3)
+    frame = pd.DataFrame({"run_id": ["a", "b", "c"], "status": ["completed", "failed", "completed"],
+                          "peak_q": [1.0, 3.0, 2.5]})
+    assert Outcome(study, summary=frame).problem() is None
+    frame.loc[1, "peak_q"] = 1.5
+    assert Outcome(study, summary=frame).problem().startswith("1 of 3 runs failed")
+
+
 def test_scan_values_are_a_grid_range_and_lines_say_how_far():
     sp = spec(low=0.05, high=0.25, tolerance=0.01)
     assert sp.scan_values() == expand_range("x", {"start": 0.05, "stop": 0.25, "num": S.SCAN_POINTS})

@@ -89,8 +89,13 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     name, quantity = search["parameter"], search["quantity"]
     if name not in summary or quantity not in summary:
         return None
+    import pandas as pd
+
     from ..quantities import quantity_of
-    done = summary[summary["status"].astype(str) == "completed"] if "status" in summary else summary
+    status = summary["status"].astype(str) if "status" in summary else pd.Series("completed", summary.index)
+    done = summary[status == "completed"]
+    # failed runs the search counted (a maximum over the limit when they stopped: limits.py)
+    failed = summary[(status == "failed") & (summary[quantity] > search["limit"])]
     q = quantity_of(quantity)
     scale, unit = (q[0].per_unit, q[0].unit) if q else (1.0, "")
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
@@ -102,6 +107,10 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
         label = ", ".join(f"{a} = {value_label(a, point[a])}" for a in axes)
         line = ax.plot(rows[name], rows[quantity] / scale, marker=_MARKERS[k % 6], ms=4, lw=1,
                        label=label or None)
+        over = failed
+        for a in axes:
+            over = over[np.isclose(over[a].astype(float), float(point[a]))] if a in over else over
+        ax.scatter(over[name], over[quantity] / scale, marker="x", s=60, color=line[0].get_color(), zorder=3)
         at = rows[rows[name] == point["search_value"]] if np.isfinite(point["search_value"]) else rows[:0]
         ax.scatter(at[name], at[quantity] / scale, s=160, facecolors="none", edgecolors=line[0].get_color(),
                    zorder=3)
@@ -109,6 +118,8 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     ax.axhline(limit, color="black", lw=1, ls="--", label=f"limit {limit:g} {unit}")
     ax.set_xlabel(axis_label(name))
     ax.set_ylabel(f"{quantity} ({unit})" if unit else quantity)
+    if len(failed):
+        ax.scatter([], [], marker="x", color="grey", label="failed over the limit (when it stopped)")
     ax.set_title(f"{quantity} of every run of the search (ringed: the run at the limit)", fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)

@@ -16,20 +16,30 @@ LIMIT_COLUMNS = ["search_value", "status", "runs", "limit_run"]
 LIMITS_FILE = "limits.csv"
 
 
+def _is_maximum(name):
+    """A quantity that is the largest value over the run (it can only grow as the run goes)."""
+    return name.startswith(("peak_", "max_"))
+
+
 def quantity_of(study, run):
     """The searched quantity of a run as the results folder has it: a number, None (the run
-    failed, or gave no number) or search.PENDING (not run, or not finished)."""
+    failed, or gave no number) or search.PENDING (not run, or not finished). A failed run
+    whose quantity is a maximum already over the limit when it stopped counts with that
+    value: the rest of the run could only have raised it (a step too high at that speed
+    throws the idler off its guide after the seat has seen its 2.5 g)."""
     if run is None:
         return S.PENDING
     rec = store.read_run(study.output, run.run_id)
     if rec is None:
         return S.PENDING
+    value = (rec.get("results") or {}).get(study.search.quantity)
+    value = None if value is None else float(value)
     if rec.get("status") == "failed":
-        return None
+        over = value is not None and _is_maximum(study.search.quantity) and value > study.search.limit
+        return value if over else None
     if not store.is_completed(study.output, run.run_id):
         return S.PENDING
-    value = (rec.get("results") or {}).get(study.search.quantity)
-    return None if value is None else float(value)
+    return value
 
 
 def run_search(study, wave, say):

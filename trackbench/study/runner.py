@@ -44,10 +44,21 @@ class Outcome:
     def failed_total(self):
         return self.counts()[0]
 
+    def _decided_failures(self):
+        """Failed runs a search counted as over its limit (limits.quantity_of: a maximum that
+        passed the limit before the run stopped): the search's answer, not a problem."""
+        from .limits import _is_maximum
+        s, df = self.study.search, self.summary
+        if s is None or df is None or s.quantity not in df or not _is_maximum(s.quantity):
+            return 0
+        return int(((df.status == "failed") & (df[s.quantity] > s.limit)).sum())
+
     def problem(self):
-        """None when every run of the study is completed and recorded; otherwise the one line
-        that goes with a nonzero exit, saying how many runs are not completed."""
+        """None when every run of the study is completed and recorded (or failed over a
+        search's limit, which decides it); otherwise the one line that goes with a nonzero
+        exit, saying how many runs are not completed."""
         failed, missing = self.counts()
+        failed -= self._decided_failures()
         n = len(self.study.runs)
         parts = ([f"{failed} of {n} runs failed"] if failed else []) + (
             [f"{missing} of {n} runs not run"] if missing else [])
