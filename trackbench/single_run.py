@@ -8,6 +8,7 @@ from .model.ground.soil import SOIL_CHOICES
 from .presets import PRESETS, preset_values
 from .quantities import accounted_balance
 from .scenario import RULES, UNITS, Scenario, ScenarioError, flatten, paper_step
+from .scenario.parameters_table import RANDOM_DEFAULTS, TERRAIN_KINDS, TERRAIN_RULES
 
 
 def parse_assignment(text):
@@ -235,10 +236,14 @@ def parameter_table():
 
     for k, rule in RULES.items():
         rows.append(row(k, str(base.get(k, "")), rule[3]))
-    rows.append(row("terrain.kind", "step", "flat, step, ramp, block, bump, points, sequence"))
+    rows.append(row("terrain.kind", "step", ", ".join(TERRAIN_KINDS)))
     rows.append(
         "terrain.height / length / position / first_contact_time / gap / points / obstacles: see README"
     )
+    for k in ("roughness_class", "rms", "seed", "wavelength_min", "wavelength_max", "run_in", "file"):
+        default = RANDOM_DEFAULTS.get(k, "")
+        kind = "profile" if k == "file" else "random"
+        rows.append(row("terrain." + k, str(default), f"{TERRAIN_RULES[k][3]} (kind {kind})"))
     rows.append(
         row("terrain.soil", "rigid", "rigid, " + ", ".join(SOIL_CHOICES[1:]) + ", or a table (docs/usage.md)")
     )
