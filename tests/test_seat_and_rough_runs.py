@@ -115,6 +115,13 @@ def test_ground_the_vehicle_cannot_stand_on_is_refused_in_one_line(tmp_path):
     assert "heights vary by 0.2 m" in str(e.value) and "\n" not in str(e.value)
 
 
+def test_a_run_that_never_reaches_the_rough_ground_is_refused_in_one_line():
+    with pytest.raises(ScenarioError) as e:
+        tb.simulate(tb.Scenario.paper(duration=0.5, terrain={**ROUGH, "run_in": 10.0}))
+    assert "the run ends before the track reaches the rough ground" in str(e.value)
+    assert "run_in below 7.56 m" in str(e.value) and "\n" not in str(e.value)
+
+
 @pytest.mark.parametrize("terrain, fragment", [
     ({"kind": "random"}, "terrain: neither roughness_class nor rms is given"),
     ({"kind": "random", "roughness_class": "J"}, "terrain.roughness_class = 'J' is not allowed"),

@@ -150,6 +150,20 @@ def _standing(x, h, eq, pad_ground):
     return h - under[0]
 
 
+def _check_reached(scenario, eq):
+    """A random ground's rough section must come under the track before the run ends: a run
+    that never leaves the run-in measures flat ground (its ride metrics near zero)."""
+    front = float(eq.info["pins"][:, 0].max()) + scenario["track.pad_ground"]
+    travel = scenario["speed"] * scenario["duration"]
+    run_in = scenario["terrain"]["run_in"]
+    if front + travel <= run_in:
+        raise ValueError(
+            f"terrain.run_in = {run_in:g} m: the run ends before the track reaches the rough ground "
+            f"(its front at x = {front:.3g} m travels speed x duration = {travel:.3g} m); allowed: "
+            f"run_in below {front + travel:.3g} m, or a longer duration or a higher speed"
+        )
+
+
 def _check_memory_laws(scenario, ground):
     """The restitution laws remember each pin's approach speed per ground segment, which a
     candidate row holds for at most SEGMENT_CANDIDATES segments (model/core/indices.py)."""
@@ -174,6 +188,8 @@ def build_ground(scenario, eq):
     if t["kind"] == "points":
         return ground_from_points(t["points"], merge_straight=True), {}
     if t["kind"] in ("random", "profile"):
+        if t["kind"] == "random":
+            _check_reached(scenario, eq)
         x, h = rough_points(t)
         h = _standing(x, h, eq, scenario["track.pad_ground"])
         ground = ground_from_points(np.column_stack([x, h]), merge_straight=True)
