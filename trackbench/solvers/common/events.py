@@ -31,8 +31,6 @@ from ...model.contact.laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
 from ...model.core import fixed_math as fm
 from ...model.core.bundles import ClosedEventWork
 from ...model.core.indices import (
-    C_CORNER_END,
-    C_CORNER_FIRST,
     G_REACH,
     K_CORNER_LINK,
     K_CORNER_PIN,
@@ -379,10 +377,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     soil = m.par[P_SOIL] != 0.0
     best = 2.0
     for kind in range(N_KINDS):
-        first, end = m.nbr_rows[kind], m.nbr_rows[kind + 1]
-        if kind == K_CORNER_LINK or kind == K_CORNER_PIN:   # the others have no candidates
-            first, end = first + m.counters[C_CORNER_FIRST], first + m.counters[C_CORNER_END]
-        for row in range(first, end):
+        for row in range(m.nbr_rows[kind], m.nbr_rows[kind + 1]):
             i = row - m.nbr_rows[kind]
             for j in range(m.nbr[row, NB_COUNT]):
                 b = m.nbr[row, 1 + j]
