@@ -1,4 +1,4 @@
-"""Issue 5: the rerun recording (read back with rerun's own reader), the plots, `trackbench view`."""
+"""The rerun recording (read back with rerun's own reader), the plots, `trackbench view`."""
 
 import json
 
