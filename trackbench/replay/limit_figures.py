@@ -73,14 +73,7 @@ def _limit_curve(limits, axes, search, out, plt):
     ax.set_ylabel(f"highest {axis_label(name)}")
     ax.set_title(f"{name} limit: {quantity} <= {search['limit']:g} (to {search['tolerance']:g})",
                  fontsize=10)
-    ax.grid(alpha=0.3)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize=8)
-    path = Path(out) / f"limit_{name.replace('.', '_')}.png"
-    fig.tight_layout()
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    return path
+    return _saved(fig, ax, Path(out) / f"limit_{name.replace('.', '_')}.png", plt, 8)
 
 
 def _quantity_figure(summary, limits, axes, search, out, plt):
@@ -100,16 +93,11 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     scale, unit = (q[0].per_unit, q[0].unit) if q else (1.0, "")
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for k, (_, point) in enumerate(limits.iterrows()):
-        rows = done
-        for a in axes:
-            rows = rows[np.isclose(rows[a].astype(float), float(point[a]))] if a in rows else rows
-        rows = rows.sort_values(name)
+        rows = _at_point(done, axes, point).sort_values(name)
         label = ", ".join(f"{a} = {value_label(a, point[a])}" for a in axes)
         line = ax.plot(rows[name], rows[quantity] / scale, marker=_MARKERS[k % 6], ms=4, lw=1,
                        label=label or None)
-        over = failed
-        for a in axes:
-            over = over[np.isclose(over[a].astype(float), float(point[a]))] if a in over else over
+        over = _at_point(failed, axes, point)
         ax.scatter(over[name], over[quantity] / scale, marker="x", s=60, color=line[0].get_color(), zorder=3)
         at = rows[rows[name] == point["search_value"]] if np.isfinite(point["search_value"]) else rows[:0]
         ax.scatter(at[name], at[quantity] / scale, s=160, facecolors="none", edgecolors=line[0].get_color(),
@@ -121,9 +109,22 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     if len(failed):
         ax.scatter([], [], marker="x", color="grey", label="failed over the limit (when it stopped)")
     ax.set_title(f"{quantity} of every run of the search (ringed: the run at the limit)", fontsize=10)
+    return _saved(fig, ax, Path(out) / f"search_{quantity}.png", plt, 7)
+
+
+def _at_point(frame, axes, point):
+    """The rows of frame at the grid point ``point`` (its values on every axis the frame has)."""
+    for a in axes:
+        if a in frame:
+            frame = frame[np.isclose(frame[a].astype(float), float(point[a]))]
+    return frame
+
+
+def _saved(fig, ax, path, plt, legend_size):
+    """The figure with its grid and legend, written to path (PNG) and closed; returns path."""
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    path = Path(out) / f"search_{quantity}.png"
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize=legend_size)
     fig.tight_layout()
     fig.savefig(path, dpi=DPI)
     plt.close(fig)

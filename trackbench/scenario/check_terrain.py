@@ -55,14 +55,7 @@ def _rough(t, kind):
 
     allowed = TERRAIN_KEYS[kind]
     out = {"kind": kind, **(RANDOM_DEFAULTS if kind == "random" else {})}
-    for k, v in t.items():
-        if k == "kind":
-            continue
-        if k not in allowed:
-            raise ScenarioError(
-                f"terrain.{k} does not apply to kind '{kind}'; allowed: {', '.join(sorted(allowed))}"
-            )
-        out[k] = check_value(f"terrain.{k}", v, TERRAIN_RULES[k], open_low=k in TERRAIN_OPEN_LOW)
+    out.update(_checked_keys(t, "terrain", f"kind '{kind}'", allowed))
     try:
         if kind == "profile":
             if "file" not in out:
@@ -127,21 +120,28 @@ def _sequence(t):
     }
 
 
+def _checked_keys(table, where, what, allowed):
+    """A terrain or obstacle table's keys but its kind, each allowed for it (what: "a step",
+    "kind 'random'") and its value checked against TERRAIN_RULES."""
+    out = {}
+    for k, v in table.items():
+        if k == "kind":
+            continue
+        if k not in allowed:
+            raise ScenarioError(
+                f"{where}.{k} does not apply to {what}; allowed: {', '.join(sorted(allowed))}"
+            )
+        out[k] = check_value(f"{where}.{k}", v, TERRAIN_RULES[k], open_low=k in TERRAIN_OPEN_LOW)
+    return out
+
+
 def _validate_obstacle(ob, where, first):
     """One obstacle: the whole terrain (where == 'terrain') or one of a sequence."""
     if not isinstance(ob, dict):
         raise ScenarioError(f'{where} must be a table like {{kind = "step", height = 0.1, position = 5.0}}')
     kind = check_value(where + ".kind", ob.get("kind"), OBSTACLE_KIND_RULE)
     allowed = OBSTACLE_KEYS[kind] if where != "terrain" else TERRAIN_KEYS[kind]
-    out = {"kind": kind}
-    for k, v in ob.items():
-        if k == "kind":
-            continue
-        if k not in allowed:
-            raise ScenarioError(
-                f"{where}.{k} does not apply to a {kind}; allowed: {', '.join(sorted(allowed))}"
-            )
-        out[k] = check_value(f"{where}.{k}", v, TERRAIN_RULES[k], open_low=k in TERRAIN_OPEN_LOW)
+    out = {"kind": kind, **_checked_keys(ob, where, f"a {kind}", allowed)}
     for need in ("height",) + (("length",) if kind != "step" else ()):
         if need not in out:
             raise ScenarioError(f"{where}.{need} is missing: a {kind} needs {need}")

@@ -25,7 +25,6 @@ from ..core.indices import (
     P_WHEEL_RADIUS,
     PN_LAST,
     SEG_LENGTH,
-    SEG_TX,
     SEG_X0,
     SEGMENT_CANDIDATES,
 )
@@ -73,13 +72,14 @@ def _near_pins(px, py, apos, last, reach, nbr, row):
 
 
 @njit(**INLINE)
-def _first_corner_beyond(corners, x, inclusive):
-    """The first corner at x or beyond (inclusive) or beyond x alone; the corners' x ascend
-    as the ground's vertices do."""
-    lo, hi = 0, corners.shape[0]
+def _first_beyond(table, col, x, inclusive):
+    """The first row of table whose column col is at x or beyond (inclusive) or beyond x
+    alone, by bisection: the ground's corners and its segments' starts ascend in x as the
+    ground's vertices do."""
+    lo, hi = 0, table.shape[0]
     while lo < hi:
         mid = (lo + hi) // 2
-        if corners[mid, 0] < x or (not inclusive and corners[mid, 0] == x):
+        if table[mid, col] < x or (not inclusive and table[mid, col] == x):
             lo = mid + 1
         else:
             hi = mid
@@ -87,52 +87,41 @@ def _first_corner_beyond(corners, x, inclusive):
 
 
 @njit(**INLINE)
-def _corner_window(apos, m, reach):
+def _track_x_range(apos):
+    """The smallest and largest x of the pins (the links lie between them)."""
+    lo, hi = apos[0, 0], apos[0, 0]
+    for b in range(apos.shape[0]):
+        lo = min(lo, apos[b, 0])
+        hi = max(hi, apos[b, 0])
+    return lo, hi
+
+
+@njit(**INLINE)
+def _corner_window(span, m, reach):
     """Clear the corner rows of the last window, then the new window: the corners within
-    reach in x of the pins (links lie between them), the only ones with candidates."""
+    reach in x of the track's span, the only ones with candidates."""
     nbr, rows, counters = m.nbr, m.nbr_rows, m.counters
     for c in range(counters[C_CORNER_FIRST], counters[C_CORNER_END]):
         nbr[rows[K_CORNER_LINK] + c, NB_COUNT] = 0
         nbr[rows[K_CORNER_PIN] + c, NB_COUNT] = 0
-    lo, hi = apos[0, 0], apos[0, 0]
-    for b in range(apos.shape[0]):
-        lo = min(lo, apos[b, 0])
-        hi = max(hi, apos[b, 0])
-    counters[C_CORNER_FIRST] = _first_corner_beyond(m.corners, lo - reach, True)
-    counters[C_CORNER_END] = _first_corner_beyond(m.corners, hi + reach, False)
+    counters[C_CORNER_FIRST] = _first_beyond(m.corners, 0, span[0] - reach, True)
+    counters[C_CORNER_END] = _first_beyond(m.corners, 0, span[1] + reach, False)
     return counters[C_CORNER_FIRST], counters[C_CORNER_END]
 
 
 @njit(**INLINE)
-def _segment_window(apos, seg, reach):
+def _segment_window(span, seg, reach):
     """(first, end) of the ground segments a pin may have as candidates: every one on a ground
     of at most SEGMENT_CANDIDATES segments (the paper's and every obstacle's: a full search),
-    else those within GROUND_WINDOW + reach of the track in x (segments sorted by x, found by
-    bisection): a rough ground's gentle slopes keep the others out of a pin's reach."""
+    else those within GROUND_WINDOW + reach of the track's span in x (the segment before the
+    first starting in it, which may reach into it, included): a rough ground's gentle slopes
+    keep the others out of a pin's reach."""
     n = seg.shape[0]
     if n <= SEGMENT_CANDIDATES:
         return 0, n
-    lo, hi = apos[0, 0], apos[0, 0]
-    for b in range(apos.shape[0]):
-        lo = min(lo, apos[b, 0])
-        hi = max(hi, apos[b, 0])
     margin = GROUND_WINDOW + reach
-    a, z = 0, n
-    while a < z:        # the first segment ending at or beyond lo - margin
-        mid = (a + z) // 2
-        if seg[mid, SEG_X0] + seg[mid, SEG_TX] * seg[mid, SEG_LENGTH] < lo - margin:
-            a = mid + 1
-        else:
-            z = mid
-    first = a
-    z = n
-    while a < z:        # the first segment starting beyond hi + margin
-        mid = (a + z) // 2
-        if seg[mid, SEG_X0] <= hi + margin:
-            a = mid + 1
-        else:
-            z = mid
-    return first, a
+    first = max(_first_beyond(seg, SEG_X0, span[0] - margin, True) - 1, 0)
+    return first, _first_beyond(seg, SEG_X0, span[1] + margin, False)
 
 
 @njit(**INLINE)
@@ -171,10 +160,11 @@ def build_neighbours(apos, wc, gc, m):
         reach_g = m.guides[j, G_REACH] + skin
         _near_links(gc[j, 0], gc[j, 1], apos, reach_g, nbr, rows[K_GUIDE_LINK] + j)
         _near_pins(gc[j, 0], gc[j, 1], apos, last, reach_g, nbr, rows[K_GUIDE_PIN] + j)
-    for c in range(*_corner_window(apos, m, max(reach_cl, hg + skin))):
+    span = _track_x_range(apos)
+    for c in range(*_corner_window(span, m, max(reach_cl, hg + skin))):
         _near_links(corners[c, 0], corners[c, 1], apos, reach_cl, nbr, rows[K_CORNER_LINK] + c)
         _near_pins(corners[c, 0], corners[c, 1], apos, last, hg + skin, nbr, rows[K_CORNER_PIN] + c)
-    window = _segment_window(apos, seg, hg + skin)
+    window = _segment_window(span, seg, hg + skin)
     for b in range(1, last + 1):
         _pin_ground_row(apos, b, seg, window, skin, hg, m)
 
