@@ -87,8 +87,8 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     from ..quantities import quantity_of
     status = summary["status"].astype(str) if "status" in summary else pd.Series("completed", summary.index)
     done = summary[status == "completed"]
-    # failed runs the search counted (a maximum over the limit when they stopped: limits.py)
-    failed = summary[(status == "failed") & (summary[quantity] > search["limit"])]
+    from ..study.limits import failed_over_limit
+    failed = summary[failed_over_limit(summary, quantity, search["limit"])]   # counted as over
     q = quantity_of(quantity)
     scale, unit = (q[0].per_unit, q[0].unit) if q else (1.0, "")
     fig, ax = plt.subplots(figsize=(7.5, 4.8))

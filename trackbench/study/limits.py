@@ -21,6 +21,17 @@ def _is_maximum(name):
     return name.startswith(("peak_", "max_"))
 
 
+def failed_over_limit(frame, quantity, limit):
+    """The rows of a summary whose run failed with a maximum already over the limit: runs
+    quantity_of counts as over it (a boolean Series; all False for a quantity that is no
+    maximum, or not in the summary)."""
+    import pandas as pd
+
+    if quantity not in frame or "status" not in frame or not _is_maximum(quantity):
+        return pd.Series(False, index=frame.index)
+    return (frame["status"].astype(str) == "failed") & (frame[quantity] > limit)
+
+
 def quantity_of(study, run):
     """The searched quantity of a run as the results folder has it: a number, None (the run
     failed, or gave no number) or search.PENDING (not run, or not finished). A failed run

@@ -47,11 +47,11 @@ class Outcome:
     def _decided_failures(self):
         """Failed runs a search counted as over its limit (limits.quantity_of: a maximum that
         passed the limit before the run stopped): the search's answer, not a problem."""
-        from .limits import _is_maximum
+        from .limits import failed_over_limit
         s, df = self.study.search, self.summary
-        if s is None or df is None or s.quantity not in df or not _is_maximum(s.quantity):
+        if s is None or df is None:
             return 0
-        return int(((df.status == "failed") & (df[s.quantity] > s.limit)).sum())
+        return int(failed_over_limit(df, s.quantity, s.limit).sum())
 
     def problem(self):
         """None when every run of the study is completed and recorded (or failed over a
