@@ -29,6 +29,9 @@ app = typer.Typer(add_completion=False, no_args_is_help=True, cls=_Group,
 STORAGE = "full|compact"
 study_app = typer.Typer(no_args_is_help=True, cls=_Group, help="Run and read parameter studies (TOML).")
 app.add_typer(study_app, name="study")
+daemon_app = typer.Typer(no_args_is_help=True, cls=_Group,
+                         help="The warm process that runs `run` and `study run` sooner (docs/usage.md).")
+app.add_typer(daemon_app, name="daemon")
 
 
 def _fail(msg: str, code: int = 2):
@@ -158,7 +161,7 @@ def study_run(
     except ValueError as e:
         _fail(str(e))
     # the workers' server first: its imports (a second) overlap the study's validation and expansion
-    start_workers(executor, scheduler, warm=LATER)
+    start_workers(executor, scheduler, warm=LATER, workers=workers)
     try:
         study = _load_study_or_fail(file, output)
         from .study import store
@@ -323,24 +326,53 @@ def record(
 
 
 
+@daemon_app.command("status", cls=_Command)
+def daemon_status():
+    """Show this user's daemons: running, commands served, which serves this environment."""
+    from .daemon.client import status
+    typer.echo(status())
+
+
+@daemon_app.command("stop", cls=_Command)
+def daemon_stop():
+    """Stop this user's daemons (the next `run` or `study run` starts one again)."""
+    from .daemon.client import stop
+    n = stop()
+    typer.echo(f"stopped {n} daemon{'s' if n != 1 else ''}")
+
+
 def _usage_error():
     """Click's UsageError, as the installed Typer has it (recent Typers carry their own Click)."""
     return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
 
 
 def main():
-    """The command; Click's own usage errors (an option of the wrong type, an unknown option or
-    command) in one line like the command's own, instead of a framed panel."""
+    """The command, run by the daemon for its settings where one is up (daemon/), else here
+    (and then a daemon is left for the next command)."""
     import sys
-    if sys.argv[1:2] == ["run"]:   # a process that runs one scenario holds numpy arrays only
+
+    from .daemon import client
+    path = client.daemon_path(sys.argv[1:])
+    code = client.run(sys.argv[1:], path)
+    if code is None:
+        code = command(sys.argv[1:])
+        client.leave_daemon(path)
+    _leave(code)
+
+
+def command(argv):
+    """Run the command ``argv``; its exit status. Click's own usage errors (an option of the
+    wrong type, an unknown option or command) in one line like the command's own, instead of
+    a framed panel."""
+    if argv[:1] == ["run"]:   # a process that runs one scenario holds numpy arrays only
         from .startup import without_dask_arrays
         without_dask_arrays()
     try:
-        code = app(standalone_mode=False, prog_name="trackbench")
+        code = app(args=list(argv), standalone_mode=False, prog_name="trackbench")
     except _usage_error() as e:
         if type(e).__name__ == "NoArgsIsHelpError":    # `trackbench study` alone: its help
             e.show()
-            sys.exit(0)
+            return 0
         where = e.ctx.command_path if e.ctx is not None else "trackbench"
         typer.secho(
             f"error: {where}: {e.format_message()} (see '{where} --help')", fg=typer.colors.RED, err=True
@@ -349,7 +381,7 @@ def main():
     except typer.Abort:
         typer.secho("error: interrupted", fg=typer.colors.RED, err=True)
         code = 130
-    _leave(code if isinstance(code, int) else 0)
+    return code if isinstance(code, int) else 0
 
 
 def _leave(code):

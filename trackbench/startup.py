@@ -1,6 +1,7 @@
 """What a process that runs the model does to start sooner (`trackbench run`, the study
 workers' server): no dask arrays where none are held. Plain module: no numba."""
 
+import os
 import sys
 
 
@@ -12,3 +13,15 @@ def without_dask_arrays():
     dask.distributed is loaded (the dask executor's workers): dask may need its arrays there."""
     if "distributed" not in sys.modules:
         sys.modules.setdefault("dask.array", None)
+
+
+def single_threaded_libraries(env=None):
+    """One BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
+    threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
+    pyarrow. In ``env`` (default: this process's) for a process to be started, since the
+    libraries read them as they load: a process that forks workers (the fork server, the
+    daemon) then has a single thread when it forks (study/preload.py)."""
+    env = os.environ if env is None else env
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env.setdefault(var, "1")
+    env.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")

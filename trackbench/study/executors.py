@@ -24,7 +24,7 @@ from pathlib import Path
 from ..quantities import run_summary
 from ..storage import frame_step, recording_steps
 from . import store
-from .warming import PRELOAD, _context, start_workers, stop_server  # noqa: F401  (the pool's server)
+from .warming import PRELOAD, _context, give_back, start_workers, stop_server, take_pool  # noqa: F401  (the pool's server)
 
 
 def _now():
@@ -268,6 +268,9 @@ def _attempt(task, number):
 
 
 def _new_pool(workers):
+    pool = take_pool(workers)   # forked at the command's start in the daemon's copy of itself
+    if pool is not None:
+        return pool
     start_workers()
     ctx = _context()
     warm = _warm if ctx.get_start_method() == "spawn" else None
@@ -319,7 +322,7 @@ def run_local(tasks, workers=2, notify=None, on_running=None):
                     yield task, (crashed(task, exc, task["attempt"]) if exc else fut.result())
     finally:
         if pool is not None:
-            pool.shutdown(wait=True, cancel_futures=True)
+            give_back(pool, idle=not running)
 
 
 def _fill(pool, fresh, retry, running, workers):

@@ -12,6 +12,8 @@ import json
 import os
 from pathlib import Path
 
+from ..startup import single_threaded_libraries
+
 WARM = "TRACKBENCH_WARM"    # the server's spec (JSON): {"scenarios": [...]} or {"file": path}; "flag"
 MAX_WARM = 4
 LATER = "later"             # start_workers(warm=LATER): the kinds come through warm_file()
@@ -81,10 +83,18 @@ def forget():
 PRELOAD = "trackbench.study.preload"
 
 
+WARM_PROCESS = False   # True in the daemon's copy of itself (daemon/serving.py): it is warm
+_POOL = []             # the pool forked from it at the command's start (start_workers)
+
+
 def _context():
     """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
-    where the platform has no fork server."""
+    where the platform has no fork server; in the daemon's copy of itself, while it has a
+    single thread, plain fork (it is warm already: its forks are)."""
     import multiprocessing
+    import threading
+    if WARM_PROCESS and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("spawn")
     ctx = multiprocessing.get_context("forkserver")
@@ -92,24 +102,27 @@ def _context():
     return ctx
 
 
-def start_workers(executor="local", scheduler=None, warm=None):
+def start_workers(executor="local", scheduler=None, warm=None, workers=None):
     """Start the fork server now (it loads in its own process while the command does its own
     set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
     scenario dicts whose models the server loads (or compiles, once for all workers, saying so
     in compile_flag()) before it forks a worker, or LATER (the command says which
     through warming.announce, once it has read the study); default: the paper's. Once the
-    server runs, a list is announced to it (when it waits for one)."""
+    server runs, a list is announced to it (when it waits for one). In the daemon's copy of
+    itself, the pool of ``workers`` local workers is forked from it instead, now, while it
+    has a single thread (take_pool)."""
+    single_threaded_libraries()
+    if _POOL:
+        return
+    if WARM_PROCESS and executor == "local" and not scheduler and workers:
+        ctx = _context()
+        if ctx.get_start_method() == "fork":
+            _POOL.append(_forked_pool(ctx, workers))
+            return
     if warm is not None and warm != LATER and _told_later():
         announce(warm)
     elif warm is not None:
         os.environ[WARM] = json.dumps(spec(warm))
-    # one BLAS thread per worker: the workers already fill the cores, and idle OpenBLAS
-    # threads spin (seen at ~6 % of a core per worker); no jemalloc background thread in
-    # pyarrow: the fork server and the workers inherit this, and so the server has a single
-    # thread when it forks (preload.py)
-    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
     if scheduler:
         return
     ctx = _context()
@@ -118,6 +131,48 @@ def start_workers(executor="local", scheduler=None, warm=None):
             ctx.set_forkserver_preload(["distributed", PRELOAD])
         from multiprocessing import forkserver
         forkserver.ensure_running()
+
+
+def _forked_pool(ctx, workers):
+    from concurrent.futures import ProcessPoolExecutor
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_forked_worker,
+                               initargs=(os.getpid(),))
+    pool.submit(int)   # a fork pool forks all its workers at its first task: now (not waited for)
+    pool.trackbench_forked = True
+    return pool
+
+
+def _forked_worker(parent):
+    """A forked worker's start. It holds both ends of its pool's queues, so it would wait for
+    work forever once the command is gone (killed): the kernel ends it with the command
+    instead (Linux). Then it imports rerun (the one library the daemon cannot hold: its import
+    starts threads) while the command reads the study."""
+    import ctypes
+    import signal
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:   # gone before the request took effect
+        os._exit(1)
+    try:
+        import rerun  # noqa: F401
+    except ImportError:
+        pass
+
+
+def take_pool(workers):
+    """The pool start_workers forked for ``workers`` workers, once; else None."""
+    return _POOL.pop() if _POOL and _POOL[0]._max_workers == workers else None
+
+
+def give_back(pool, idle):
+    """At the end of a wave: a forked pool left ``idle`` waits for the next wave (a search's);
+    any other pool is shut down."""
+    if idle and getattr(pool, "trackbench_forked", False):
+        _POOL.append(pool)
+    else:
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _server_pid():
@@ -134,6 +189,8 @@ def stop_server():
     to the dying one."""
     import signal
     from multiprocessing import forkserver
+    while _POOL:
+        _POOL.pop().shutdown(wait=False, cancel_futures=True)
     pid = _server_pid()
     if pid is not None:
         try:

@@ -1,0 +1,190 @@
+"""The daemon (trackbench/daemon/): a command it serves does what the command does in its own
+process (same output, same files bit for bit, same exit status), only sooner; an interrupt
+reaches the runs; a command with other code or settings is not served; it leaves when told
+or idle. Each test's daemons live in a folder of their own (XDG_RUNTIME_DIR)."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from trackbench.daemon import address, client
+
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+
+
+def environment(runtime, **extra):
+    env = {**os.environ, "TRACKBENCH_DAEMON": "on", "XDG_RUNTIME_DIR": str(runtime),
+           "TRACKBENCH_DAEMON_IDLE": "120", **extra}
+    return env
+
+
+def cli(args, env, cwd, **kw):
+    return subprocess.run(CLI + args, env=env, cwd=cwd, capture_output=True, text=True, **kw)
+
+
+def served(runtime):
+    """The commands this folder's daemons served (their log lines)."""
+    lines = []
+    for log in Path(runtime, f"trackbench-{os.getuid()}").glob("*.log"):
+        lines += [json.loads(x) for x in log.read_text().splitlines()]
+    return lines
+
+
+def sockets(runtime):
+    return sorted(Path(runtime, f"trackbench-{os.getuid()}").glob("*.sock"))
+
+
+def wait_for(predicate, seconds=90.0):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < seconds:
+        if predicate():
+            return True
+        time.sleep(0.1)
+    return False
+
+
+@pytest.fixture(scope="module")
+def daemon(tmp_path_factory):
+    """A daemon left by a first command (run in its own process), and that command's folder."""
+    base = tmp_path_factory.mktemp("daemon")
+    runtime = base / "rt"
+    runtime.mkdir(mode=0o700)
+    env = environment(runtime)
+    first = cli(["run", "--duration", "0.01", "--out", "local"], env, base)
+    assert first.returncode == 0, first.stderr
+    assert wait_for(lambda: sockets(runtime)), "no daemon came up"
+    yield base, runtime, env, first
+    cli(["daemon", "stop"], env, base)
+
+
+def strip_times(text):
+    return [line for line in text.splitlines() if "wall time" not in line and "written:" not in line]
+
+
+def test_a_served_run_is_the_run_of_the_command(daemon):
+    base, runtime, env, first = daemon
+    before = len(served(runtime))
+    out = cli(["run", "--duration", "0.01", "--out", "served"], env, base)
+    assert out.returncode == 0, out.stderr
+    assert len(served(runtime)) == before + 1          # the daemon ran it
+    assert strip_times(out.stdout) == strip_times(first.stdout)
+    a = xr.load_dataset(base / "local" / "paper_step.nc")
+    b = xr.load_dataset(base / "served" / "paper_step.nc")
+    for name in a.variables:
+        assert np.array_equal(a[name].values, b[name].values, equal_nan=a[name].dtype.kind == "f"), name
+    assert (base / "served" / "paper_step.rrd").stat().st_size > 0
+
+
+def test_bad_input_gets_the_same_error_and_status(daemon):
+    base, runtime, env, _ = daemon
+    out = cli(["run", "--set", "speed=-3", "--out", "bad"], env, base)
+    here = cli(["run", "--set", "speed=-3", "--out", "bad"], {**env, "TRACKBENCH_DAEMON": "off"}, base)
+    assert served(runtime)[-1]["argv"][:3] == ["run", "--set", "speed=-3"]
+    assert (out.returncode, out.stdout, out.stderr) == (here.returncode, here.stdout, here.stderr)
+    assert out.returncode == 2 and "speed = -3" in out.stderr
+
+
+def test_a_served_study_runs_on_forked_workers(daemon):
+    base, runtime, env, _ = daemon
+    (base / "two.toml").write_text('[study]\nname = "two"\n[scenario]\nduration = 0.02\n'
+                                   '[grid]\nspeed = [8.0, 12.0]\n')
+    out = cli(["study", "run", "two.toml"], env, base)
+    assert out.returncode == 0, out.stderr
+    assert served(runtime)[-1]["argv"] == ["study", "run", "two.toml"]
+    here = cli(["study", "run", "two.toml", "--output", "results/here"], {**env, "TRACKBENCH_DAEMON": "off"},
+               base)
+    assert here.returncode == 0, here.stderr
+    a = (base / "results" / "two" / "summary.csv").read_text().splitlines()
+    b = (base / "results" / "here" / "summary.csv").read_text().splitlines()
+    keep = [i for i, c in enumerate(a[0].split(",")) if "time" not in c or "peak" in c]
+    assert [[r.split(",")[i] for i in keep] for r in a] == [[r.split(",")[i] for i in keep] for r in b]
+
+
+def test_ctrl_c_reaches_the_runs_and_keeps_what_is_done(daemon):
+    base, runtime, env, _ = daemon
+    (base / "long.toml").write_text('[study]\nname = "long"\n[scenario]\nduration = 20.0\n'
+                                    '[grid]\nspeed = [5.0, 6.0, 7.0, 8.0]\n')
+    proc = subprocess.Popen(CLI + ["study", "run", "long.toml"], env=env, cwd=base, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 130, stderr
+    assert "interrupted" in stderr
+    copy = served(runtime)[-1]
+    assert copy["exit"] == 130
+    assert wait_for(lambda: not _group_alive(copy["pid"]), 10), "a worker of the study outlived it"
+
+
+def _group_alive(pgid):
+    try:
+        os.killpg(pgid, 0)
+        return True
+    except ProcessLookupError:
+        return False
+
+
+def test_a_killed_command_stops_its_copy(daemon):
+    base, runtime, env, _ = daemon
+    n = len(served(runtime))
+    proc = subprocess.Popen(CLI + ["run", "--duration", "30", "--out", "killed"], env=env, cwd=base,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    time.sleep(2.0)
+    proc.kill()
+    proc.wait()
+    assert wait_for(lambda: len(served(runtime)) > n, 30), "the copy ran on"
+    assert served(runtime)[-1]["exit"] != 0
+    assert not (base / "killed" / "paper_step.nc").exists()
+
+
+def test_other_settings_are_not_served_by_it(daemon):
+    base, runtime, env, _ = daemon
+    n = len(served(runtime))
+    other = {**env, "NUMBA_OPT": "3"}   # numba's default, said: another setting
+    assert address.key(other) != address.key(env)
+    out = cli(["run", "--duration", "0.01", "--out", "other"], other, base)
+    assert out.returncode == 0
+    assert len(served(runtime)) == n
+    assert wait_for(lambda: len(sockets(runtime)) == 2)   # it left one of its own
+    status = cli(["daemon", "status"], env, base).stdout
+    assert "serves this environment" in status and "other code or settings" in status
+
+
+def test_stop_and_idle_leave_no_daemon(tmp_path):
+    runtime = Path(tempfile.mkdtemp(prefix="tb"))   # short: a socket's path holds at most 107 bytes
+    env = environment(runtime, TRACKBENCH_DAEMON_IDLE="3")
+    assert cli(["run", "--duration", "0.01", "--out", "a"], env, tmp_path).returncode == 0
+    assert wait_for(lambda: sockets(runtime))
+    assert wait_for(lambda: not sockets(runtime), 30), "the idle daemon stayed"
+    assert not list(runtime.glob("*/*.json"))
+    env["TRACKBENCH_DAEMON_IDLE"] = "120"
+    assert cli(["run", "--duration", "0.01", "--out", "a", "--force"], env, tmp_path).returncode == 0
+    assert wait_for(lambda: sockets(runtime))
+    out = cli(["daemon", "stop"], env, tmp_path)
+    assert out.stdout.strip() == "stopped 1 daemon"
+    assert not sockets(runtime) and "no daemon is running" in cli(["daemon", "status"], env, tmp_path).stdout
+
+
+def test_which_commands_a_daemon_serves(tmp_path, monkeypatch):
+    assert address.eligible(["run", "--duration", "1"])
+    assert address.eligible(["study", "run", "a.toml", "-w", "1"])
+    for argv in (["study", "status", "a.toml"], ["run", "--help"], ["plot", "x"], [],
+                 ["study", "run", "a.toml", "--executor", "dask"], ["study", "run", "a.toml", "--scheduler=tcp://h:1"]):
+        assert not address.eligible(argv), argv
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    path = address.socket_path()
+    path.write_text("")    # a socket left by a daemon that died: the command runs here
+    assert client.run(["run"], path) is None and not path.exists()
+    monkeypatch.setenv("TRACKBENCH_DAEMON", "on")
+    assert client.daemon_path(["run"]) == path
+    monkeypatch.setenv("TRACKBENCH_DAEMON", "off")
+    assert client.daemon_path(["run"]) is None

@@ -1,0 +1,7 @@
+"""python -m trackbench.daemon SOCKET: the daemon (started by a command: client.leave_daemon)."""
+
+import sys
+
+from .serving import main
+
+main(sys.argv[1])
