@@ -16,10 +16,11 @@ storage  the same sweep with --storage compact: the largest run folder full / co
 --reference  compare the sweep's summary.csv numbers and every array of every timeseries.nc
          bit for bit with a results folder of the same sweep written by another version
 dask     the sweep on a dask LocalCluster of 2 worker processes against the process pool
-fixed    what every command pays: a one-run study of 0.01 s, and `trackbench run --duration 0.01`
+fixed    what every command pays: a one-run study of 0.01 s, and `trackbench run --duration 0.01`,
+         served by the daemon and in their own process
 long     benchmarks/long_runs.toml (16 runs of ~2 s solve) with 1 and 2 workers: speed-up, and
          the per-run work outside the solve from run.json
-big      1,000 runs of 0.01 s (recordings off): the command's memory as runs accumulate, then
+big      1,000 runs of 0.01 s (recordings off, in the command's own process): its memory as runs accumulate, then
          `study status`, write_summary and open_study_dataset on the folder
 """
 
@@ -263,32 +264,56 @@ def part_dask(cwd, repeat):
 ONE = '[study]\nname = "one"\n[scenario]\nduration = 0.01\n'
 
 
-def timed(cwd, args):
+def timed(cwd, args, env=None):
     """Wall time (s) of one whole trackbench command in ``cwd``, its output thrown away."""
     t = time.perf_counter()
-    r = subprocess.run(CLI + args, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    r = subprocess.run(CLI + args, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                       env=env)
     if r.returncode != 0:
         raise SystemExit(f"trackbench {' '.join(args)} failed: {r.stderr[-2000:]}")
     return time.perf_counter() - t
 
 
+def daemon_up(cwd, seconds=120.0):
+    """Wait until a daemon serves this environment (the first command leaves it)."""
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < seconds:
+        out = subprocess.run(CLI + ["daemon", "status"], cwd=cwd, capture_output=True, text=True).stdout
+        if any("running" in line and "serves this environment" in line for line in out.splitlines()):
+            return True
+        time.sleep(0.5)
+    return False
+
+
 def part_fixed(cwd, repeat):
     """What every command pays: a one-run study of 0.01 s and `trackbench run --duration 0.01`,
-    whole commands (fresh process, fresh results), alternated."""
+    whole commands (fresh process, fresh results), alternated: served by the daemon (up and
+    warm: a first command left it) and each in its own process (TRACKBENCH_DAEMON=off)."""
     (cwd / "one.toml").write_text(ONE)
+    own = {**os.environ, "TRACKBENCH_DAEMON": "off"}
+    timed(cwd, ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"])
+    if not daemon_up(cwd):
+        print("no daemon came up: the daemon's figures below are of commands in their own process")
 
-    def study():
-        shutil.rmtree(cwd / "results" / "one", ignore_errors=True)
-        return {"wall": timed(cwd, ["study", "run", "one.toml"])}
+    def study(env):
+        def fn():
+            shutil.rmtree(cwd / "results" / "one", ignore_errors=True)
+            return {"wall": timed(cwd, ["study", "run", "one.toml"], env)}
+        return fn
 
-    def run():
-        return {"wall": timed(cwd, ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"])}
+    def run(env):
+        args = ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"]
+        return lambda: {"wall": timed(cwd, args, env)}
 
-    res = alternate(repeat, {"study": study, "run": run})
+    cases = {"study": study(None), "study own": study(own), "run": run(None), "run own": run(own)}
+    res = alternate(repeat, cases)
     print(f"\n== fixed cost, whole command, {repeat} alternating rounds (median [min, max])")
     for name, label in (("study", "study run of one 0.01 s run"), ("run", "trackbench run --duration 0.01")):
-        w = [r["wall"] for r in res[name]]
-        print(f"{label:32s} {statistics.median(w):.2f} s [{min(w):.2f}, {max(w):.2f}] (target <= 1 s)")
+        w, o = [r["wall"] for r in res[name]], [r["wall"] for r in res[name + " own"]]
+        ratio = [a / b for a, b in zip(w, o)]
+        print(f"{label:32s} daemon {statistics.median(w):.2f} s [{min(w):.2f}, {max(w):.2f}] "
+              f"(target <= 1 s); own process {statistics.median(o):.2f} s [{min(o):.2f}, {max(o):.2f}]; "
+              f"ratio {statistics.median(ratio):.2f}")
 
 
 def long_case(cwd, workers):
@@ -350,8 +375,9 @@ def part_big(cwd, n=1000, repeat=5):
     out = cwd / "results" / "big"
     shutil.rmtree(out, ignore_errors=True)
     t = time.perf_counter()
+    # in its own process (not the daemon's copy): the coordinator's memory is that process's
     proc = subprocess.Popen(CLI + ["study", "run", "big.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+                            stderr=subprocess.DEVNULL, env={**os.environ, "TRACKBENCH_DAEMON": "off"})
     rows = sample_memory(proc, out)
     wall = time.perf_counter() - t
     recs = records(out)
