@@ -20,8 +20,8 @@ fixed    what every command pays: a one-run study of 0.01 s, and `trackbench run
          served by the daemon and in their own process
 long     benchmarks/long_runs.toml (16 runs of ~2 s solve) with 1 and 2 workers: speed-up, and
          the per-run work outside the solve from run.json
-big      1,000 runs of 0.01 s (recordings off, in the command's own process): its memory as runs accumulate, then
-         `study status`, write_summary and open_study_dataset on the folder
+big      1,000 runs of 0.01 s (recordings off, in the command's own process): its memory as
+         runs accumulate, then `study status`, write_summary and open_study_dataset on the folder
 """
 
 import argparse
