@@ -161,7 +161,7 @@ def study_run(
     except ValueError as e:
         _fail(str(e))
     # the workers' server first: its imports (a second) overlap the study's validation and expansion
-    start_workers(executor, scheduler, warm=LATER, workers=workers)
+    start_workers(executor, scheduler, warm=LATER)
     try:
         study = _load_study_or_fail(file, output)
         from .study import store
@@ -169,6 +169,8 @@ def study_run(
         announce(warm_kinds(r.scenario for r in todo))   # what the server loads (or compiles) for the workers
         from .study.runner import check_output
         check_output(study)   # a folder that cannot be written, or that holds another study's results
+        if todo:   # in the daemon's copy: its workers forked now, while it has one thread
+            start_workers(executor, scheduler, workers=workers)
     except ValueError as e:
         stop_server()
         _fail(str(e))

@@ -81,6 +81,12 @@ def _preload():
             __import__(name)
         except ImportError:
             pass
+    table = pandas.DataFrame({"a": [1.0], "b": ["x"]})   # the summary's writers load their parts
+    table.to_csv(io.StringIO())
+    try:
+        table.to_parquet(io.BytesIO())
+    except ImportError:
+        pass
 
 
 def _describe(path):
