@@ -188,3 +188,17 @@ def test_which_commands_a_daemon_serves(tmp_path, monkeypatch):
     assert client.daemon_path(["run"]) == path
     monkeypatch.setenv("TRACKBENCH_DAEMON", "off")
     assert client.daemon_path(["run"]) is None
+
+
+def test_an_edited_package_sends_its_daemon_away(tmp_path):
+    runtime = Path(tempfile.mkdtemp(prefix="tb"))
+    env = environment(runtime)
+    assert cli(["run", "--duration", "0.01", "--out", "a"], env, tmp_path).returncode == 0
+    assert wait_for(lambda: sockets(runtime))
+    source = Path(address.PACKAGE) / "daemon" / "__main__.py"
+    st = source.stat()
+    try:
+        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))   # as an edit would
+        assert wait_for(lambda: not sockets(runtime), 30), "the daemon of the old sources stayed"
+    finally:
+        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))

@@ -66,6 +66,12 @@ def _libraries():
     return found
 
 
+def stamp():
+    """The package's sources and the installed libraries as they are now: a daemon leaves once
+    they change (no command would be handed to it again)."""
+    return hashlib.sha1("\0".join(_sources() + _libraries()).encode("utf-8", "surrogateescape")).hexdigest()
+
+
 def key(env=None):
     env = os.environ if env is None else env
     digest = hashlib.sha1()

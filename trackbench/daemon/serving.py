@@ -25,6 +25,7 @@ from pathlib import Path
 
 IDLE = float(os.environ.get("TRACKBENCH_DAEMON_IDLE", 900.0))   # s without a command, then it leaves
 TICK = 0.5      # s: how often it looks at its socket file (removed: it leaves) and its copies
+LOOK = 5.0      # s: how often it looks at the package's sources and the libraries (5 ms a look)
 MAX_REQUEST = 1 << 20   # bytes
 # what rerun imports that starts no thread (a third of its import): loaded here, once; with
 # the progress display and the command line's conversion of values (pydantic), loaded late
@@ -128,7 +129,8 @@ def _listen(path):
 
 
 def _serve(listener, path, inode):
-    copies, idle_since = set(), time.monotonic()
+    from .address import stamp
+    copies, idle_since, code, looked = set(), time.monotonic(), stamp(), time.monotonic()
     listener.settimeout(TICK)
     while True:
         _reap(copies)
@@ -139,6 +141,10 @@ def _serve(listener, path, inode):
         except socket.timeout:
             if not _still_ours(path, inode) or (not copies and time.monotonic() - idle_since > IDLE):
                 break
+            if not copies and time.monotonic() - looked > LOOK:
+                looked = time.monotonic()
+                if stamp() != code:   # edited or upgraded: no command will be handed to it again
+                    break
             continue
         with conn:
             request, fds = _receive(conn)
