@@ -17,7 +17,13 @@ blocks (velocity block symmetrised) as a fixed linear part. The phi functions of
 block come from the exponential of an augmented matrix (scipy); the coordinates without a
 block have the nilpotent [[0, 1], [0, 0]].
 
+A method name ending in x takes the whole Jacobian f'(y) (forward differences of every
+column) as J, in p only the pins' rows and columns of it, in b every pin's own block and the
+bodies' rows and columns (no coupling between pins): exprb43x, exprb43p, exprb43b.
+
     python benchmarks/exprb_profile.py                       # one step from 0.20 s and 0.35 s
+    python benchmarks/exprb_profile.py one --starts 0.35 --advance 2.5e-6 --where
+    python benchmarks/exprb_profile.py one --methods exprb43,exprb43x,exprb43p,exprb43b
     python benchmarks/exprb_profile.py window --start 0.20 --window 0.03
     python benchmarks/exprb_profile.py one --blocks full     # J's position columns differenced too
 """
@@ -77,14 +83,20 @@ class DenseLinear:
     """The whole Jacobian f'(y) (forward differences, ny right-hand sides) and its phi
     functions: what the methods' order asks for, too dear for a run, measured on one step."""
 
-    def __init__(self, w, y, f0, pins_only=False):
+    def __init__(self, w, y, f0, part="x"):
         n = y.size
         self.J = np.empty((n, n))
         for j in range(n):
             yp = y.copy()
             yp[j] += PJ.SQRT_EPS * max(abs(y[j]), 1e-3 if j < w.nq else 1e-1)
             self.J[:, j] = (w.f(yp) - f0) / (yp[j] - y[j])
-        if pins_only:   # the pins' rows and columns (their coupling too); the kinematic identity elsewhere
+        if part == "b":   # every pin's own block and the bodies' rows and columns; no pin-pin coupling
+            pin = np.full(n, -1)
+            for b in range(w.jw.blk.shape[0]):
+                pin[w.jw.blk[b, :4]] = b
+            between = (pin[:, None] >= 0) & (pin[None, :] >= 0) & (pin[:, None] != pin[None, :])
+            self.J[between] = 0.0
+        if part == "p":   # the pins' rows and columns (their coupling too); the kinematic identity elsewhere
             keep = np.zeros(n, dtype=bool)
             keep[w.jw.blk[:, 2:].ravel()] = True
             kin = self.J[: w.nq].copy()
@@ -192,8 +204,8 @@ def one_step(w, method, y, f0, h, tol, full):
         blocks(w, y, f0)
         yn, _, r = ark_step(w, y, f0, h, tol, ARK5)
         return yn, float(np.sqrt(r.mean()))
-    if method[-1] in "xp":   # the whole Jacobian (x), the pins' part of it (p)
-        lin = DenseLinear(w, y, f0, method[-1] == "p")
+    if method[-1] in "xpb":   # the whole Jacobian (x), the pins' part of it (p), no pin-pin coupling (b)
+        lin = DenseLinear(w, y, f0, method[-1])
         yn, _, er, _ = EXPONENTIAL[method[:-1]][0](w, y, f0, h, lin)
         return yn, norm(w, y, yn, er, tol)
     J, _ = blocks(w, y, f0, full and method not in SYMMETRISED)
@@ -240,7 +252,7 @@ def one_step_table(starts, steps, methods, tol, full, overrides, show_where=Fals
 def window(w, method, span, tol, full):
     """Accepted and rejected steps, right-hand sides and step sizes over `span` from the
     window's start, J renewed every attempt, the plain controller (no event location)."""
-    dense = method[-1] in "xp"
+    dense = method[-1] in "xpb"
     step, expo = EXPONENTIAL[method[:-1] if dense else method]
     y, h, t = w.y0.copy(), 1e-6, 0.0
     f0 = w.f(y)
@@ -248,7 +260,7 @@ def window(w, method, span, tol, full):
     while t < span * (1.0 - 1e-12):
         h = min(h, span - t)
         if dense:
-            lin, nj = DenseLinear(w, y, f0, method[-1] == "p"), y.size
+            lin, nj = DenseLinear(w, y, f0, method[-1]), y.size
         else:
             J, nj = blocks(w, y, f0, full)
             lin = Linear(w, symmetrised(J) if method in SYMMETRISED else J)
