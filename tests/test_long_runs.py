@@ -178,3 +178,16 @@ def test_a_long_recording_is_written_block_by_block(tmp_path):
     frames, rows = sorted(times[E.E_CHASSIS]), sorted(times[E.E_WHEEL_FY])
     assert len(rows) == n and len(frames) == len(range(0, n, 20)) + (0 if (n - 1) % 20 == 0 else 1)
     assert np.allclose(frames[:3], [0.0, 0.02, 0.04]) and frames[-1] == pytest.approx(float(ds.time[-1]))
+
+
+def test_the_step_cap_grows_with_the_simulated_time():
+    """max_steps = 0 (the default) caps a run at 400,000 steps a simulated second, at least
+    2,000,000 (a 20 s closed-track run takes about 3.2 million); a number caps it at that."""
+    from trackbench.solvers.base import control
+    cap = {d: control(tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": d})).max_steps
+           for d in (0.5, 5.0, 20.0, 60.0)}
+    assert cap == {0.5: 2_000_000, 5.0: 2_000_000, 20.0: 8_000_000, 60.0: 24_000_000}
+    sc = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 20.0, "max_steps": 10_000})
+    assert control(sc).max_steps == 10_000
+    with pytest.raises(tb.ScenarioError, match="max_steps = -1 is not allowed"):
+        tb.Scenario.from_dict({"max_steps": -1})

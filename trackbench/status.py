@@ -36,9 +36,9 @@ _MESSAGES = {
     Result.CORNER_THROUGH_TRACK: (
         "a ground corner went through the track (corner crossed a link's centre line)"
     ),
-    Result.MAX_STEPS: "the maximum number of steps was reached (max_steps; the closed track with "
-    "friction takes about 100,000 a simulated second with dopri5: raise max_steps, or use "
-    "method = \"ark548l2sa\", which integrates the stuck pins' friction implicitly)",
+    Result.MAX_STEPS: "the maximum number of steps was reached (max_steps; by default 400,000 a "
+    "simulated second, where the closed track with friction takes about 160,000 with dopri5: raise "
+    "max_steps, or loosen the tolerance)",
     Result.CONSTRAINT_ITERATION: "the Lagrange-multiplier iteration did not converge",
     Result.PIN_THROUGH_SPROCKET: "a track pin went into a sprocket tooth (it jumped the teeth)",
     Result.IDLER_OFF_GUIDE: "the idler ran off the end of its guide (idler.travel)",

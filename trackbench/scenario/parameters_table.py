@@ -44,7 +44,7 @@ def paper_step():
         "tolerance": 1e-9,
         "output_interval": 1e-4,
         "max_step": 1e-4,   # s, 0: none; the paper preset: the output interval on obstacles (presets.py)
-        "max_steps": 2_000_000,
+        "max_steps": 0,       # 0: STEPS_PER_SECOND a simulated second, at least MIN_STEPS (solvers/base.py)
         "perturbation": 0.0,  # m: seeded nudge of the free pins (study replicates)
         "seed": 0,
         "vehicle": paper_vehicle(),
@@ -81,7 +81,7 @@ RULES = {
                         "a number > 0 (s; default 1e-4 on obstacles, 1e-3 on flat ground)"),
     "max_step": (float, 0.0, 1000.0, "a number in [0, 1000] s (0: no cap, the error control alone; "
                  "default: the output interval for the paper preset on obstacles, else 0)"),
-    "max_steps": (int, 1, 10**9, "an integer >= 1"),
+    "max_steps": (int, 0, 10**9, "an integer >= 0 (0: 400,000 a simulated second, at least 2,000,000)"),
     "perturbation": (float, 0.0, 1e-3, "a number in [0, 1e-3] m"),
     "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
     "vehicle.chassis_mass": _POS,

@@ -81,7 +81,20 @@ def control(scenario):
     dt_out = float(scenario["output_interval"])
     h_max = min(float(scenario["max_step"]) or t_end, (CHUNK_ROWS - 1) * dt_out)
     return Control(t_end, dt_out, float(tol), float(tol), min(H0, h_max), h_max, H_MIN,
-                   int(scenario["max_steps"]), n_samples(scenario))
+                   step_cap(scenario), n_samples(scenario))
+
+
+STEPS_PER_SECOND = 400_000   # max_steps = 0: the closed track with friction takes ~160,000 a second
+MIN_STEPS = 2_000_000
+
+
+def step_cap(scenario):
+    """The accepted + rejected steps after which a run stops (Result.MAX_STEPS): max_steps, or
+    with max_steps = 0, in proportion to the simulated time (a guard against a run whose steps
+    collapse, not a bound on a long run)."""
+    if int(scenario["max_steps"]):
+        return int(scenario["max_steps"])
+    return max(MIN_STEPS, int(STEPS_PER_SECOND * float(scenario["duration"])))
 
 
 def n_samples(scenario):
