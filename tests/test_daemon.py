@@ -202,3 +202,22 @@ def test_an_edited_package_sends_its_daemon_away(tmp_path):
         assert wait_for(lambda: not sockets(runtime), 30), "the daemon of the old sources stayed"
     finally:
         os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
+def test_a_daemon_loads_kernels_from_the_cache_and_never_compiles():
+    """A kernel not in numba's cache would be compiled: the daemon refuses (it would take a core
+    for a minute, unasked) and leaves that kind for after a command; a cached kind loads."""
+    import numba
+
+    from trackbench.daemon import serving
+
+    @numba.njit
+    def never_compiled(x):
+        return x + 1
+
+    with pytest.raises(serving._Uncached):
+        with serving._cached_only():
+            never_compiled(1)
+    assert never_compiled(1) == 2   # outside, numba compiles as ever
+    assert serving.warm_kinds([{}]) == []   # the paper's kernels: in the cache (the suite ran them)
+    assert serving.warm_kinds([{"speed": -1.0}]) == [{"speed": -1.0}]   # not runnable: left

@@ -27,6 +27,9 @@ IDLE = float(os.environ.get("TRACKBENCH_DAEMON_IDLE", 900.0))   # s without a co
 TICK = 0.5      # s: how often it looks at its socket file (removed: it leaves) and its copies
 LOOK = 5.0      # s: how often it looks at the package's sources and the libraries (5 ms a look)
 MAX_REQUEST = 1 << 20   # bytes
+# the kinds of model whose kernels a daemon holds (where numba's cache has them), as scenario dicts
+KINDS = ({}, {"track": {"layout": "closed"}, "preset": "damped", "drive": {"kind": "speed"}})
+TINY = {"duration": 1e-3, "output_interval": 1e-3}
 # what rerun imports that starts no thread (a third of its import): loaded here, once; with
 # the progress display and the command line's conversion of values (pydantic), loaded late
 RERUN_LIBRARIES = ("psutil", "PIL.Image", "attr", "attrs", "typing_extensions", "colorsys", "asyncio")
@@ -38,8 +41,8 @@ def main(path):
     from .client import starting, unusable
     why = None
     try:
-        _preload()
-        threads = len(os.listdir("/proc/self/task"))
+        left = _preload()
+        threads = _threads()
         if threads != 1:
             why = f"{threads} threads after loading the libraries (a fork needs one)"
         else:
@@ -52,31 +55,25 @@ def main(path):
     if why is not None:   # said once: the commands of this key start no daemon again
         Path(unusable(Path(path))).write_text(why + "\n")
         return
-    _serve(listener, path, inode)
+    _serve(listener, path, inode, left)
+
+
+def _threads():
+    return len(os.listdir("/proc/self/task"))
 
 
 def _preload():
     """What `trackbench run` and `study run` load: the command line, the package, xarray,
-    pandas, netCDF4, and the compiled kernels of the paper's model and of the closed track,
-    with a tiny run of each written to a netCDF file (HDF5's set-up)."""
+    pandas, netCDF4, the writers of the summary, and the compiled kernels of the paper's model
+    and of the closed track where numba's cache has them. Returns the kinds left to load."""
     from ..startup import without_dask_arrays
     without_dask_arrays()   # a daemon serves no dask study (address.eligible)
     import netCDF4  # noqa: F401
-    import pandas  # noqa: F401
+    import pandas
     import xarray  # noqa: F401
 
-    import trackbench
     from trackbench import cli, single_run  # noqa: F401
-    from trackbench.output import write_netcdf
-    from trackbench.quantities import run_summary
     from trackbench.study import executors, progress, runner, summary  # noqa: F401
-    short = {"duration": 1e-3, "output_interval": 1e-3}
-    closed = {"track": {"layout": "closed"}, "preset": "damped", "drive": {"kind": "speed"}, **short}
-    for sc in (trackbench.Scenario.paper(**short), trackbench.Scenario.from_dict(closed)):
-        ds = trackbench.simulate(sc)
-        run_summary(ds)
-        with tempfile.TemporaryDirectory() as tmp:
-            write_netcdf(ds, os.path.join(tmp, "warm.nc"))
     for name in ("pyarrow", "rich.progress", "typer._adapters") + RERUN_LIBRARIES:   # where installed
         try:
             __import__(name)
@@ -88,6 +85,56 @@ def _preload():
         table.to_parquet(io.BytesIO())
     except ImportError:
         pass
+    return warm_kinds(list(KINDS))
+
+
+def warm_kinds(kinds):
+    """Load each kind's kernels from numba's cache with a tiny run of it, its summary and its
+    netCDF file (HDF5's set-up). Never compile: a daemon compiling for a minute unasked would
+    take a core from the user's next commands; a kind not in the cache yet is left for later
+    (a command may compile it meanwhile). Returns the kinds left."""
+    import trackbench
+    from trackbench.output import write_netcdf
+    from trackbench.quantities import run_summary
+    left = []
+    for kind in kinds:
+        try:
+            with _cached_only():
+                ds = trackbench.simulate(trackbench.Scenario.from_dict({**kind, **TINY}))
+            run_summary(ds)
+            with tempfile.TemporaryDirectory() as tmp:
+                write_netcdf(ds, os.path.join(tmp, "warm.nc"))
+        except Exception:  # noqa: BLE001  (not cached, or not runnable here: the command will say)
+            left.append(kind)
+    return left
+
+
+class _Uncached(Exception):
+    pass
+
+
+class _cached_only:
+    """While active, numba's start of a compilation (it loads from its cache without one)
+    raises _Uncached instead."""
+
+    def __enter__(self):
+        from numba.core import event
+
+        class Refuse(event.Listener):
+            def on_start(self, ev):
+                raise _Uncached(str(ev.data))
+
+            def on_end(self, ev):
+                pass
+
+        self.listener = Refuse()
+        event.register("numba:compile", self.listener)
+        return self
+
+    def __exit__(self, *exc):
+        from numba.core import event
+        event.unregister("numba:compile", self.listener)
+        return False
 
 
 def _describe(path):
@@ -128,23 +175,47 @@ def _listen(path):
     return listener, os.stat(path).st_ino
 
 
-def _serve(listener, path, inode):
-    from .address import stamp
-    copies, idle_since, code, looked = set(), time.monotonic(), stamp(), time.monotonic()
+class _Idle:
+    """What the daemon does between commands: it leaves when its socket is gone, after IDLE
+    seconds, or once its sources or libraries changed (no command will be handed to it again);
+    after a command, it loads the kinds that command may have compiled."""
+
+    def __init__(self, path, inode, left):
+        from .address import stamp
+        self.path, self.inode, self.left, self.code = path, inode, left, stamp()
+        self.since = self.looked = time.monotonic()
+        self.served = False
+
+    def busy(self):
+        self.since, self.served = time.monotonic(), True
+
+    def leave(self):
+        from .address import stamp
+        now = time.monotonic()
+        if not _still_ours(self.path, self.inode) or now - self.since > IDLE:
+            return True
+        if now - self.looked > LOOK:
+            self.looked = now
+            if stamp() != self.code:
+                return True
+        if self.left and self.served:
+            self.served, self.left = False, warm_kinds(self.left)
+            return _threads() != 1   # it could no longer fork safely
+        return False
+
+
+def _serve(listener, path, inode, left):
+    copies, idle = set(), _Idle(path, inode, left)
     listener.settimeout(TICK)
     while True:
         _reap(copies)
         if copies:
-            idle_since = time.monotonic()
+            idle.busy()
         try:
             conn, _ = listener.accept()
         except socket.timeout:
-            if not _still_ours(path, inode) or (not copies and time.monotonic() - idle_since > IDLE):
+            if not copies and idle.leave():
                 break
-            if not copies and time.monotonic() - looked > LOOK:
-                looked = time.monotonic()
-                if stamp() != code:   # edited or upgraded: no command will be handed to it again
-                    break
             continue
         with conn:
             request, fds = _receive(conn)
@@ -153,6 +224,7 @@ def _serve(listener, path, inode):
                 if pid == 0:
                     _copy(conn, listener, request, fds, path)   # never returns
                 copies.add(pid)
+                idle.busy()
             for fd in fds:
                 os.close(fd)
     if _still_ours(path, inode):
