@@ -5,6 +5,7 @@ or idle. Each test's daemons live in a folder of their own (XDG_RUNTIME_DIR)."""
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -43,6 +44,14 @@ def sockets(runtime):
     return sorted(Path(runtime, f"trackbench-{os.getuid()}").glob("*.sock"))
 
 
+@pytest.fixture
+def runtime():
+    """A short folder for daemons' sockets (a socket's path holds at most 107 bytes)."""
+    path = Path(tempfile.mkdtemp(prefix="tb"))
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
+
+
 def wait_for(predicate, seconds=90.0):
     t0 = time.monotonic()
     while time.monotonic() - t0 < seconds:
@@ -76,7 +85,7 @@ def test_a_served_run_is_the_run_of_the_command(daemon):
     out = cli(["run", "--duration", "0.01", "--out", "served"], env, base)
     assert out.returncode == 0, out.stderr
     assert len(served(runtime)) == before + 1          # the daemon ran it
-    assert strip_times(out.stdout) == strip_times(first.stdout)
+    assert strip_times(out.stdout) == strip_times(first.stdout) and out.stderr == first.stderr
     a = xr.load_dataset(base / "local" / "paper_step.nc")
     b = xr.load_dataset(base / "served" / "paper_step.nc")
     for name in a.variables:
@@ -159,8 +168,7 @@ def test_other_settings_are_not_served_by_it(daemon):
     assert "serves this environment" in status and "other code or settings" in status
 
 
-def test_stop_and_idle_leave_no_daemon(tmp_path):
-    runtime = Path(tempfile.mkdtemp(prefix="tb"))   # short: a socket's path holds at most 107 bytes
+def test_stop_and_idle_leave_no_daemon(tmp_path, runtime):
     env = environment(runtime, TRACKBENCH_DAEMON_IDLE="3")
     assert cli(["run", "--duration", "0.01", "--out", "a"], env, tmp_path).returncode == 0
     assert wait_for(lambda: sockets(runtime))
@@ -174,13 +182,13 @@ def test_stop_and_idle_leave_no_daemon(tmp_path):
     assert not sockets(runtime) and "no daemon is running" in cli(["daemon", "status"], env, tmp_path).stdout
 
 
-def test_which_commands_a_daemon_serves(tmp_path, monkeypatch):
+def test_which_commands_a_daemon_serves(runtime, monkeypatch):
     assert address.eligible(["run", "--duration", "1"])
     assert address.eligible(["study", "run", "a.toml", "-w", "1"])
     for argv in (["study", "status", "a.toml"], ["run", "--help"], ["plot", "x"], [],
                  ["study", "run", "a.toml", "--executor", "dask"], ["study", "run", "a.toml", "--scheduler=tcp://h:1"]):
         assert not address.eligible(argv), argv
-    monkeypatch.setenv("XDG_RUNTIME_DIR", str(tmp_path))
+    monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
     path = address.socket_path()
     path.write_text("")    # a socket left by a daemon that died: the command runs here
     assert client.run(["run"], path) is None and not path.exists()
@@ -190,18 +198,16 @@ def test_which_commands_a_daemon_serves(tmp_path, monkeypatch):
     assert client.daemon_path(["run"]) is None
 
 
-def test_an_edited_package_sends_its_daemon_away(tmp_path):
-    runtime = Path(tempfile.mkdtemp(prefix="tb"))
-    env = environment(runtime)
-    assert cli(["run", "--duration", "0.01", "--out", "a"], env, tmp_path).returncode == 0
-    assert wait_for(lambda: sockets(runtime))
-    source = Path(address.PACKAGE) / "daemon" / "__main__.py"
-    st = source.stat()
-    try:
-        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000_000))   # as an edit would
-        assert wait_for(lambda: not sockets(runtime), 30), "the daemon of the old sources stayed"
-    finally:
-        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))
+def test_an_edited_package_or_library_sends_its_daemon_away(monkeypatch):
+    """A daemon looks at its sources and libraries every LOOK seconds and leaves once they are
+    not what its key was made of (no command would be handed to it again)."""
+    from trackbench.daemon import serving
+    idle = serving._Idle("/nonexistent", 0, [], None, address.stamp())
+    monkeypatch.setattr(serving, "_still_ours", lambda path, inode: True)
+    idle.looked = -1e9
+    assert not idle.leave()             # as it was
+    idle.code, idle.looked = "another", -1e9
+    assert idle.leave()                 # edited or upgraded
 
 
 def test_a_daemon_loads_kernels_from_the_cache_and_never_compiles():
@@ -221,3 +227,42 @@ def test_a_daemon_loads_kernels_from_the_cache_and_never_compiles():
     assert never_compiled(1) == 2   # outside, numba compiles as ever
     assert serving.warm_kinds([{}]) == []   # the paper's kernels: in the cache (the suite ran them)
     assert serving.warm_kinds([{"speed": -1.0}]) == [{"speed": -1.0}]   # not runnable: left
+
+
+def test_the_copy_takes_on_the_commands_umask_and_ignored_signals(daemon):
+    """A served command is the command's process: its umask (the files' modes) and the signals
+    it was started with ignored (nohup: a hangup does not stop it)."""
+    base, runtime, env, _ = daemon
+    n = len(served(runtime))
+    out = subprocess.run(["sh", "-c", "umask 077; exec \"$@\"", "sh", *CLI, "run", "--duration", "0.01",
+                          "--out", "private"], env=env, cwd=base, capture_output=True, text=True)
+    assert out.returncode == 0 and len(served(runtime)) == n + 1
+    assert (base / "private" / "paper_step.nc").stat().st_mode & 0o777 == 0o600
+    proc = subprocess.Popen(CLI + ["run", "--duration", "1.5", "--out", "nohup"], env=env, cwd=base,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGHUP)
+    assert proc.wait(60) == 0 and (base / "nohup" / "paper_step.nc").exists()
+    assert served(runtime)[-1]["argv"][-1] == "nohup"
+
+
+def test_a_stopped_daemon_is_passed_by(daemon):
+    """A daemon that does not answer (stopped, swamped) costs the command FIRST_REPLY seconds:
+    it then runs in its own process."""
+    base, runtime, env, _ = daemon
+    assert cli(["run", "--duration", "0.01", "--out", "probe"], env, base).returncode == 0
+    logs = Path(runtime, f"trackbench-{os.getuid()}").glob("*.log")
+    log = next(p for p in logs if "probe" in p.read_text())
+    pid = json.loads(log.with_suffix(".json").read_text())["pid"]    # the daemon that serves env
+    n = len(served(runtime))
+    os.kill(pid, signal.SIGSTOP)
+    try:
+        t0 = time.monotonic()
+        out = cli(["run", "--duration", "0.01", "--out", "passed_by"], env, base, timeout=120)
+        assert out.returncode == 0 and time.monotonic() - t0 > client.FIRST_REPLY
+    finally:
+        os.kill(pid, signal.SIGCONT)
+    assert wait_for(lambda: len(served(runtime)) >= n, 10)
+    time.sleep(1.0)
+    assert all(x["argv"][-1] != "passed_by" or x["exit"] != 0 for x in served(runtime)[n:])

@@ -170,7 +170,7 @@ def study_run(
         from .study.runner import check_output
         check_output(study)   # a folder that cannot be written, or that holds another study's results
         if todo:   # in the daemon's copy: its workers forked now, while it has one thread
-            start_workers(executor, scheduler, workers=workers)
+            start_workers(executor, scheduler, workers=min(workers, len(todo)))
     except ValueError as e:
         stop_server()
         _fail(str(e))

@@ -1,7 +1,7 @@
-"""python -m trackbench.daemon SOCKET: the daemon (started by a command: client.leave_daemon)."""
+"""python -m trackbench.daemon SOCKET STAMP: the daemon (started by a command: client.leave_daemon)."""
 
 import sys
 
 from .serving import main
 
-main(sys.argv[1])
+main(sys.argv[1], sys.argv[2])

@@ -19,7 +19,7 @@ OFF = {"0", "off", "no", "false"}
 # the environment variables a daemon's imports read (they are part of its key)
 KEYED = ("NUMBA_", "OPENBLAS_", "OMP_", "MKL_", "NPY_", "PYTHON", "LD_", "GLIBC_", "JE_", "HDF5_",
          "TRACKBENCH_", "XDG_CACHE_HOME", "HOME", "TMPDIR")
-MAX_PATH = 100   # bytes: an AF_UNIX address holds at most 107
+MAX_PATH = 94    # bytes: an AF_UNIX address holds at most 107, and the socket is built as PATH.PID.tmp
 PACKAGE = Path(__file__).resolve().parents[1]
 
 
@@ -52,12 +52,16 @@ def _sources():
     return found
 
 
-def _libraries():
+def _libraries(paths=None):
     """The modification time of every folder on the import path: installing, upgrading or
     removing a library changes its folder's (pip renames its files there)."""
-    found, here = [], os.getcwd()
-    for entry in sys.path:
-        if entry in ("", ".", here):   # the current folder: not a library's, and it changes
+    try:
+        here = os.getcwd()
+    except OSError:
+        here = ""
+    found, skip = [], ("", ".", here, str(PACKAGE.parent))
+    for entry in sys.path if paths is None else paths:
+        if entry in skip:   # the current folder and this package's: not a library's, and they change
             continue
         try:
             found.append(f"{entry}:{os.stat(entry).st_mtime_ns}")
@@ -66,21 +70,24 @@ def _libraries():
     return found
 
 
-def stamp():
-    """The package's sources and the installed libraries as they are now: a daemon leaves once
-    they change (no command would be handed to it again)."""
-    return hashlib.sha1("\0".join(_sources() + _libraries()).encode("utf-8", "surrogateescape")).hexdigest()
+def stamp(paths=None):
+    """The package's sources and the installed libraries (on the import path ``paths``, default
+    this process's) as they are now: part of the key; a daemon leaves once they change (no
+    command would be handed to it again)."""
+    parts = _sources() + _libraries(paths)
+    return hashlib.sha1("\0".join(parts).encode("utf-8", "surrogateescape")).hexdigest()
 
 
-def key(env=None):
+def key(env=None, code=None):
+    """The key of a daemon for this interpreter, environment and ``code`` (stamp())."""
     env = os.environ if env is None else env
     digest = hashlib.sha1()
     settings = sorted(
         f"{k}={v}" for k, v in env.items() if k.startswith(KEYED) and not k.startswith(SWITCH)
     )
-    # the interpreter itself and its environment (a venv's python and python3 are one)
-    interpreter = [os.path.realpath(sys.executable), sys.prefix, sys.version]
-    for part in [*interpreter, str(PACKAGE), *_sources(), *_libraries(), *settings]:
+    # the interpreter itself, its flags and its environment (a venv's python and python3 are one)
+    interpreter = [os.path.realpath(sys.executable), sys.prefix, sys.version, repr(sys.flags)]
+    for part in [*interpreter, str(PACKAGE), code or stamp(), *settings]:
         digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
     return digest.hexdigest()[:16]
 
@@ -88,22 +95,23 @@ def key(env=None):
 def folder():
     """This user's folder of daemon sockets (mode 0700), or None where it is not safe to use
     (another owner, open to others) or cannot be made."""
+    import stat
     base = os.environ.get("XDG_RUNTIME_DIR") or tempfile.gettempdir()
     path = Path(base) / f"trackbench-{os.getuid()}"
     try:
         path.mkdir(mode=0o700, exist_ok=True)
-        st = path.stat()
+        st = path.lstat()   # not a link to somewhere else
     except OSError:
         return None
-    if st.st_uid != os.getuid() or st.st_mode & 0o077:
+    if not stat.S_ISDIR(st.st_mode) or st.st_uid != os.getuid() or st.st_mode & 0o077:
         return None
     return path
 
 
-def socket_path(env=None):
+def socket_path(env=None, code=None):
     """Where the daemon for this command's key listens, or None (no safe folder)."""
     where = folder()
     if where is None:
         return None
-    path = where / f"{key(env)}.sock"
+    path = where / f"{key(env, code)}.sock"
     return path if len(os.fsencode(path)) <= MAX_PATH else None

@@ -2,9 +2,11 @@
 and leave a daemon behind for the next one. Standard library only.
 
 The conversation over the daemon's socket: the command sends its arguments, its current
-folder and its environment (JSON, length first) with its standard input, output and error
-(the descriptors themselves: the command's copy in the daemon writes to this terminal);
-the daemon answers "pid N" once its copy runs and "exit N" when it ends. A Ctrl-C (or a
+folder, its environment and its process attributes (JSON, length first); the daemon says
+"ready"; the command sends its standard input, output and error (the descriptors
+themselves: the command's copy in the daemon writes to this terminal); the daemon answers
+"pid N" once its copy runs (or "refused: why": the command then runs in its own process)
+and "exit N" when it ends. A Ctrl-C (or a
 SIGTERM, SIGHUP) here is passed on as one byte; the copy treats it as the Ctrl-C it would
 have had, and so does every process it started. Should this process die, its copy hears
 the socket close and stops the same way."""
@@ -23,12 +25,17 @@ from . import address
 START_LOCK_AGE = 60.0   # s: a "starting" mark older than this is a daemon that never came up
 
 
+CODE = []   # the stamp of the sources and libraries this command started with
+PATHS = "TRACKBENCH_DAEMON_PATHS"
+
+
 def daemon_path(argv):
     """The socket of the daemon that would serve the command ``argv`` (None: no daemon serves
-    it), by the settings it starts with (a command may change its own environment)."""
+    it), by the code and settings it starts with (a command may change its own environment)."""
     if not (address.enabled() and address.eligible(argv)):
         return None
-    return address.socket_path()
+    CODE[:] = [address.stamp()]
+    return address.socket_path(code=CODE[0])
 
 
 def run(argv, path):
@@ -66,17 +73,53 @@ def _streams():
     return fds
 
 
-def _converse(sock, argv):
-    body = json.dumps({"argv": list(argv), "cwd": os.getcwd(), "env": dict(os.environ)}).encode()
+FIRST_REPLY = 5.0   # s: a daemon that does not answer within this (stopped, swamped) is passed by
+PASSED_ON = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def _attributes():
+    """What a process inherits besides its environment, which the copy takes on: the umask,
+    the nice level, the processors, the resource limits, the cgroup, the signals ignored."""
+    import resource
+    mask = os.umask(0)
+    os.umask(mask)
+    limits = {name: resource.getrlimit(getattr(resource, name))
+              for name in dir(resource) if name.startswith("RLIMIT_")}
     try:
-        socket.send_fds(sock, [struct.pack("!I", len(body)) + body], _streams())
-        replies = sock.makefile("rb")
-        if not replies.readline().startswith(b"pid "):
-            return None   # the daemon is leaving (idle): run here
+        with open("/proc/self/cgroup") as f:
+            cgroup = f.read()
     except OSError:
-        return None
-    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-        signal.signal(sig, lambda *_: _pass_on(sock))
+        cgroup = ""
+    ignored = [int(s) for s in PASSED_ON if signal.getsignal(s) == signal.SIG_IGN]
+    return {"umask": mask, "nice": os.getpriority(os.PRIO_PROCESS, 0), "limits": limits,
+            "cpus": sorted(os.sched_getaffinity(0)), "cgroup": cgroup, "ignored": ignored}
+
+
+def _converse(sock, argv):
+    try:
+        request = {"argv": list(argv), "cwd": os.getcwd(), "env": dict(os.environ), **_attributes()}
+        _check_peer(sock)
+        body = json.dumps(request).encode()
+        sock.settimeout(FIRST_REPLY)
+        sock.sendall(struct.pack("!I", len(body)) + body)
+        replies = sock.makefile("rb")
+        if replies.readline() != b"ready\n":
+            return None
+        socket.send_fds(sock, [b"f"], _streams())   # the terminal, once the daemon is there to take it
+        first = replies.readline()
+        sock.settimeout(None)
+    except (OSError, ValueError):
+        return None   # no daemon to speak of (gone, stopped, another user's): run here
+    except KeyboardInterrupt:
+        sys.stderr.write("error: interrupted\n")
+        return 130
+    if not first.startswith(b"pid "):
+        return None   # the daemon is leaving (idle) or cannot take on this command: run here
+    for sig in PASSED_ON:
+        if signal.getsignal(sig) != signal.SIG_IGN:   # nohup, a background job: left as they are
+            signal.signal(sig, lambda *_: _pass_on(sock, b"i"))
+    group = int(first.split()[1])   # the copy leads a process group of its own
+    signal.signal(signal.SIGTSTP, lambda *_: _suspend(group))
     line = replies.readline()
     if line.startswith(b"exit "):
         return int(line.split()[1])
@@ -85,11 +128,33 @@ def _converse(sock, argv):
     return 1
 
 
-def _pass_on(sock):
+def _check_peer(sock):
+    """The daemon must be this user's (its folder is; this holds should the folder be swapped)."""
+    uid = struct.unpack("3i", sock.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, 12))[1]
+    if uid != os.getuid():
+        raise ValueError(f"the daemon's socket belongs to uid {uid}")
+
+
+def _pass_on(sock, what):
     try:
-        sock.send(b"i")
+        sock.send(what)
     except OSError:
         pass
+
+
+def _suspend(group):
+    """Ctrl-Z: the copy and its workers stop with this process, and go on with it (`fg`)."""
+    def go_on(*_):
+        try:
+            os.killpg(group, signal.SIGCONT)
+        except OSError:
+            pass
+    signal.signal(signal.SIGCONT, go_on)
+    try:
+        os.killpg(group, signal.SIGSTOP)
+    except OSError:
+        pass
+    os.kill(os.getpid(), signal.SIGSTOP)
 
 
 def _unlink(path):
@@ -109,8 +174,10 @@ def leave_daemon(path):
     single_threaded_libraries(env)   # read as the daemon's libraries load
     paths = [str(address.PACKAGE.parent)] + [p for p in [env.get("PYTHONPATH")] if p]
     env["PYTHONPATH"] = os.pathsep.join(paths)   # the daemon starts in / and imports this package
+    env[PATHS] = json.dumps(sys.path)   # the import path this command's stamp was taken on
     try:
-        subprocess.Popen([sys.executable, "-m", "trackbench.daemon", os.fspath(path)], env=env, cwd="/",
+        code = CODE[0] if CODE else address.stamp()
+        subprocess.Popen([sys.executable, "-m", "trackbench.daemon", os.fspath(path), code], env=env, cwd="/",
                          stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                          start_new_session=True, close_fds=True)
     except OSError:

@@ -35,27 +35,28 @@ TINY = {"duration": 1e-3, "output_interval": 1e-3}
 RERUN_LIBRARIES = ("psutil", "PIL.Image", "attr", "attrs", "typing_extensions", "colorsys", "asyncio")
 
 
-def main(path):
+def main(path, code):
     """Load, listen at ``path`` (the socket named by the key of the command that started it),
-    serve; remove the socket when leaving."""
-    from .client import starting, unusable
-    why = None
-    try:
-        left = _preload()
-        threads = _threads()
-        if threads != 1:
-            why = f"{threads} threads after loading the libraries (a fork needs one)"
-        else:
-            _describe(path)
-            listener, inode = _listen(path)
-    except Exception as e:  # noqa: BLE001  (no daemon then: commands run in their own processes)
-        why = f"{type(e).__name__}: {e}"
-    finally:
-        Path(starting(Path(path))).unlink(missing_ok=True)
-    if why is not None:   # said once: the commands of this key start no daemon again
-        Path(unusable(Path(path))).write_text(why + "\n")
+    serve; remove the socket when leaving. ``code``: that command's address.stamp(), the sources
+    and libraries it ran: should they have changed since, this daemon would not be what its
+    key says, and it does not start. A daemon that cannot fork safely says why once (then no
+    daemon is started for its key again); a failed start is tried again a minute later."""
+    from .address import stamp
+    from .client import PATHS, starting, unusable
+    paths = json.loads(os.environ.pop(PATHS, "null"))
+    if stamp(paths) != code:
         return
-    _serve(listener, path, inode, left)
+    left = _preload()   # an exception leaves the start's mark: no new start for a minute
+    threads = _threads()
+    if threads != 1:
+        Path(unusable(Path(path))).write_text(f"{threads} threads after loading the libraries "
+                                              "(a process that forks needs one)\n")
+        Path(starting(Path(path))).unlink(missing_ok=True)
+        return
+    listener, inode = _listen(path)
+    _describe(path)
+    Path(starting(Path(path))).unlink(missing_ok=True)
+    _serve(listener, path, inode, left, paths, code)
 
 
 def _threads():
@@ -180,9 +181,8 @@ class _Idle:
     seconds, or once its sources or libraries changed (no command will be handed to it again);
     after a command, it loads the kinds that command may have compiled."""
 
-    def __init__(self, path, inode, left):
-        from .address import stamp
-        self.path, self.inode, self.left, self.code = path, inode, left, stamp()
+    def __init__(self, path, inode, left, paths, code):
+        self.path, self.inode, self.left, self.paths, self.code = path, inode, left, paths, code
         self.since = self.looked = time.monotonic()
         self.served = False
 
@@ -196,7 +196,7 @@ class _Idle:
             return True
         if now - self.looked > LOOK:
             self.looked = now
-            if stamp() != self.code:
+            if stamp(self.paths) != self.code:
                 return True
         if self.left and self.served:
             self.served, self.left = False, warm_kinds(self.left)
@@ -204,8 +204,8 @@ class _Idle:
         return False
 
 
-def _serve(listener, path, inode, left):
-    copies, idle = set(), _Idle(path, inode, left)
+def _serve(listener, path, inode, left, paths, code):
+    copies, idle = set(), _Idle(path, inode, left, paths, code)
     listener.settimeout(TICK)
     while True:
         _reap(copies)
@@ -258,48 +258,98 @@ def _still_ours(path, inode):
 
 
 def _receive(conn):
-    """(request, its three descriptors) from a command of this user; (None, fds) otherwise."""
+    """(request, its three descriptors) from a command of this user; (None, fds) otherwise. The
+    descriptors come only once this daemon has said it is ready: a command that gave up on a
+    daemon that did not answer (stopped) has sent none, so none is held here for it."""
     conn.settimeout(5.0)
+    fds = []
     try:
         uid = struct.unpack("3i", conn.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED, 12))[1]
-        data, fds, _, _ = socket.recv_fds(conn, 65536, 3)
-        if uid != os.getuid() or len(data) < 4 or len(fds) != 3:
+        size = struct.unpack("!I", _exactly(conn, 4))[0]
+        if uid != os.getuid() or size > MAX_REQUEST:
             return None, fds
-        size = struct.unpack("!I", data[:4])[0]
-        data = data[4:]
-        while len(data) < min(size, MAX_REQUEST):
-            more = conn.recv(65536)
-            if not more:
-                return None, fds
-            data += more
-        return json.loads(data[:size]), fds
+        request = json.loads(_exactly(conn, size))
+        conn.sendall(b"ready\n")
+        _, fds, _, _ = socket.recv_fds(conn, 1, 3)
+        return (request if len(fds) == 3 else None), fds
     except (OSError, ValueError, struct.error):
-        return None, []
+        return None, fds
+
+
+def _exactly(conn, n):
+    data = b""
+    while len(data) < n:
+        more = conn.recv(min(n - len(data), 65536))
+        if not more:
+            raise ValueError("the command closed its connection")
+        data += more
+    return data
+
+
+class _Refused(Exception):
+    """The copy cannot be the command's process (a limit or a priority it cannot take on)."""
 
 
 def _copy(conn, listener, request, fds, path):
-    """The daemon's copy that runs one command, then exits with its status."""
-    code, started = 1, time.monotonic()
+    """The daemon's copy that runs one command, then exits with its status (never returns into
+    the daemon's loop: whatever happens, it ends in os._exit)."""
+    code, started, ran = 1, time.monotonic(), False
     try:
-        listener.close()
-        conn.settimeout(None)
-        os.setpgid(0, 0)
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-        for i, fd in enumerate(fds):
-            os.dup2(fd, i)
-            os.close(fd)
-        _as_the_command(request)
-        conn.sendall(f"pid {os.getpid()}\n".encode())
-        _interrupt_on(conn)
-        from .. import cli
-        code = cli.command(request["argv"])
-    except SystemExit as e:
-        code = e.code if isinstance(e.code, int) else int(e.code is not None)
-    except BaseException:  # noqa: BLE001  (whatever it was, the command hears a status)
-        traceback.print_exc()
+        try:
+            listener.close()
+            conn.settimeout(None)
+            os.setpgid(0, 0)
+            _take_on(request)
+            for i, fd in enumerate(fds):
+                os.dup2(fd, i)
+                os.close(fd)
+            _as_the_command(request)
+            conn.sendall(f"pid {os.getpid()}\n".encode())
+            ran = True
+            _interrupt_on(conn)
+            from .. import cli
+            code = cli.command(request["argv"])
+        except _Refused as e:   # the command runs in its own process instead
+            conn.sendall(f"refused: {e}\n".encode())
+        except SystemExit as e:
+            code = e.code if isinstance(e.code, int) else int(e.code is not None)
+        except BaseException:  # noqa: BLE001  (whatever it was, the command hears a status)
+            traceback.print_exc()
+        finally:
+            for sig in (signal.SIGINT, signal.SIGIO):   # a second Ctrl-C cannot cut the ending short
+                signal.signal(sig, signal.SIG_IGN)
+            if ran:
+                _log(path, request, code, started)
+                _end(conn, code)
     finally:
-        _log(path, request, code, started)
-        _end(conn, code)
+        os._exit(code)
+
+
+def _take_on(request):
+    """The command's process attributes: its cgroup (else refused), umask, nice level (never
+    higher a priority than the daemon's), processors, resource limits and ignored signals."""
+    import resource
+    try:
+        with open("/proc/self/cgroup") as f:
+            if f.read() != request.get("cgroup", ""):
+                raise _Refused("the command runs in another cgroup")
+    except OSError:
+        pass
+    os.umask(int(request["umask"]))
+    nice, now = int(request["nice"]), os.getpriority(os.PRIO_PROCESS, 0)
+    if nice < now:
+        raise _Refused(f"the command's nice level {nice} is below the daemon's {now}")
+    os.setpriority(os.PRIO_PROCESS, 0, nice)
+    try:
+        os.sched_setaffinity(0, request["cpus"])
+        for name, limit in request["limits"].items():
+            if hasattr(resource, name):
+                resource.setrlimit(getattr(resource, name), tuple(limit))
+    except (OSError, ValueError) as e:
+        raise _Refused(f"its processors or resource limits: {e}") from None
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    for sig in request.get("ignored", []):
+        signal.signal(sig, signal.SIG_IGN)
 
 
 def _as_the_command(request):
@@ -321,8 +371,9 @@ def _as_the_command(request):
 
 
 def _interrupt_on(conn):
-    """A byte from the command (its Ctrl-C) or its end (killed) interrupts this copy and every
-    process it started, as a Ctrl-C would: SIGIO on the socket, SIGINT to the group."""
+    """A byte from the command (its Ctrl-C) or its end (killed, or gone before this copy began)
+    interrupts this copy and every process it started, as a Ctrl-C would: SIGIO on the socket,
+    SIGINT to the group."""
     def heard(*_):
         try:
             conn.recv(64, socket.MSG_DONTWAIT)
@@ -336,6 +387,9 @@ def _interrupt_on(conn):
     fd = conn.fileno()
     fcntl.fcntl(fd, fcntl.F_SETOWN, os.getpid())
     fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_ASYNC)
+    from ..study import warming
+    warming.INHERITED[:] = [fd]   # forked workers close it: the command's end is this copy's
+    heard()   # SIGIO says what changes: a command already gone is seen here
 
 
 def _end(conn, code):
@@ -349,9 +403,7 @@ def _end(conn, code):
             stream.flush()
         except (OSError, ValueError):
             pass
-    signal.signal(signal.SIGIO, signal.SIG_IGN)
     try:
         conn.sendall(f"exit {code}\n".encode())
     except OSError:
         pass
-    os._exit(code)

@@ -85,16 +85,14 @@ PRELOAD = "trackbench.study.preload"
 
 WARM_PROCESS = False   # True in the daemon's copy of itself (daemon/serving.py): it is warm
 _POOL = []             # the pool forked from it at the command's start (start_workers)
+INHERITED = []         # descriptors of the copy its forked workers close (the command's socket)
 
 
 def _context():
     """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
-    where the platform has no fork server; in the daemon's copy of itself, while it has a
-    single thread, plain fork (it is warm already: its forks are)."""
+    where the platform has no fork server. (The daemon's copy forks its first pool itself:
+    start_workers.)"""
     import multiprocessing
-    import threading
-    if WARM_PROCESS and threading.active_count() == 1:
-        return multiprocessing.get_context("fork")
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return multiprocessing.get_context("spawn")
     ctx = multiprocessing.get_context("forkserver")
@@ -114,11 +112,10 @@ def start_workers(executor="local", scheduler=None, warm=None, workers=None):
     single_threaded_libraries()
     if _POOL:
         return
-    if WARM_PROCESS and executor == "local" and not scheduler and workers:
-        ctx = _context()
-        if ctx.get_start_method() == "fork":
-            _POOL.append(_forked_pool(ctx, workers))
-            return
+    if WARM_PROCESS and executor == "local" and not scheduler and workers and _one_thread():
+        import multiprocessing
+        _POOL.append(_forked_pool(multiprocessing.get_context("fork"), workers))
+        return
     if warm is not None and warm != LATER and _told_later():
         announce(warm)
     elif warm is not None:
@@ -131,6 +128,14 @@ def start_workers(executor="local", scheduler=None, warm=None, workers=None):
             ctx.set_forkserver_preload(["distributed", PRELOAD])
         from multiprocessing import forkserver
         forkserver.ensure_running()
+
+
+def _one_thread():
+    """Has this process one thread (any thread: numba's, BLAS', Python's), so it may fork?"""
+    try:
+        return len(os.listdir("/proc/self/task")) == 1
+    except OSError:
+        return False
 
 
 def _forked_pool(ctx, workers):
@@ -155,6 +160,11 @@ def _forked_worker(parent):
         pass
     if os.getppid() != parent:   # gone before the request took effect
         os._exit(1)
+    for fd in INHERITED:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
     try:
         import rerun  # noqa: F401
     except ImportError:
@@ -162,8 +172,9 @@ def _forked_worker(parent):
 
 
 def take_pool(workers):
-    """The pool start_workers forked for ``workers`` workers, once; else None."""
-    return _POOL.pop() if _POOL and _POOL[0]._max_workers == workers else None
+    """The pool start_workers forked (for at most ``workers`` workers: for as many as there
+    were runs to do), once; else None."""
+    return _POOL.pop() if _POOL and _POOL[0]._max_workers <= workers else None
 
 
 def give_back(pool, idle):
