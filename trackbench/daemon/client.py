@@ -262,17 +262,18 @@ def status():
 def stop(wait=5.0):
     """Stop this user's daemons: each leaves when its socket is gone (within a second, once the
     commands it runs have ended); the number stopped."""
-    pids = []
+    pids, stopped = [], 0
     where = address.folder()
     for bad in where.glob("*.unusable") if where is not None else []:
         _unlink(bad)   # stop forgets them too: the next command tries again
     for sock, info in _daemons():
         _unlink(sock)
         pids.append(info.get("pid"))
+        stopped += _alive(info.get("pid"))
         if not _alive(info.get("pid")):   # gone without its files: they go now
             for suffix in (".json", ".log"):
                 _unlink(sock.with_suffix(suffix))
     t0 = time.monotonic()
     while any(_alive(p) for p in pids) and time.monotonic() - t0 < wait:
         time.sleep(0.05)
-    return len(pids)
+    return stopped

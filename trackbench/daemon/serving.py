@@ -361,10 +361,9 @@ def _as_the_command(request):
     from ..study import warming
     warming.WARM_PROCESS = True
     sys.argv = ["trackbench", *request["argv"]]
-    for fd, name in ((1, "stdout"), (2, "stderr")):
-        raw = io.FileIO(fd, "w", closefd=False)
-        stream = io.TextIOWrapper(raw, encoding="utf-8", errors="backslashreplace",
-                                  line_buffering=os.isatty(fd), write_through=fd == 2)
+    for fd, name in ((1, "stdout"), (2, "stderr")):   # buffered: a short write is written whole
+        stream = open(fd, "w", buffering=1 if fd == 2 or os.isatty(fd) else -1, encoding="utf-8",
+                      errors="backslashreplace", closefd=False)
         setattr(sys, name, stream)
         setattr(sys, f"__{name}__", stream)
     sys.stdin = sys.__stdin__ = io.TextIOWrapper(io.FileIO(0, "r", closefd=False), encoding="utf-8")
