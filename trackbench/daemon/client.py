@@ -177,9 +177,10 @@ def leave_daemon(path):
     env[PATHS] = json.dumps(sys.path)   # the import path this command's stamp was taken on
     try:
         code = CODE[0] if CODE else address.stamp()
-        subprocess.Popen([sys.executable, "-m", "trackbench.daemon", os.fspath(path), code], env=env, cwd="/",
-                         stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                         start_new_session=True, close_fds=True)
+        flags = subprocess._args_from_interpreter_flags()   # -O, -X ...: part of its key (as multiprocessing)
+        command = [sys.executable, *flags, "-m", "trackbench.daemon", os.fspath(path), code]
+        subprocess.Popen(command, env=env, cwd="/", stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                         stderr=subprocess.DEVNULL, start_new_session=True, close_fds=True)
     except OSError:
         _unlink(starting(path))
 
