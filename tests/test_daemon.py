@@ -188,6 +188,10 @@ def test_which_commands_a_daemon_serves(runtime, monkeypatch):
     for argv in (["study", "status", "a.toml"], ["run", "--help"], ["plot", "x"], [],
                  ["study", "run", "a.toml", "--executor", "dask"], ["study", "run", "a.toml", "--scheduler=tcp://h:1"]):
         assert not address.eligible(argv), argv
+    monkeypatch.chdir(runtime)
+    (runtime / ".numba_config.yaml").write_text("")   # numba's settings of this folder: not the daemon's
+    assert not address.eligible(["run"])
+    (runtime / ".numba_config.yaml").unlink()
     monkeypatch.setenv("XDG_RUNTIME_DIR", str(runtime))
     path = address.socket_path()
     path.write_text("")    # a socket left by a daemon that died: the command runs here

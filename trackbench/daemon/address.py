@@ -18,7 +18,8 @@ SWITCH = "TRACKBENCH_DAEMON"     # "off" (or 0, no, false): every command runs i
 OFF = {"0", "off", "no", "false"}
 # the environment variables a daemon's imports read (they are part of its key)
 KEYED = ("NUMBA_", "OPENBLAS_", "OMP_", "MKL_", "NPY_", "PYTHON", "LD_", "GLIBC_", "JE_", "HDF5_",
-         "TRACKBENCH_", "XDG_CACHE_HOME", "HOME", "TMPDIR")
+         "TRACKBENCH_", "XDG_CACHE_HOME", "HOME", "TMPDIR", "LANG", "LC_")
+NUMBA_CONFIG = ".numba_config.yaml"   # numba reads it from the folder it is imported in
 MAX_PATH = 94    # bytes: an AF_UNIX address holds at most 107, and the socket is built as PATH.PID.tmp
 PACKAGE = Path(__file__).resolve().parents[1]
 
@@ -30,8 +31,9 @@ def enabled(env=None):
 
 def eligible(argv):
     """The commands a daemon serves: `run` and `study run` (they load the model), not a dask
-    study (its workers are dask's) and not a request for help."""
-    if not argv or any(a in ("--help", "-h") for a in argv):
+    study (its workers are dask's), not a request for help, and not in a folder with a numba
+    configuration file (the daemon's numba was set up without it)."""
+    if not argv or any(a in ("--help", "-h") for a in argv) or os.path.exists(NUMBA_CONFIG):
         return False
     if argv[0] == "run":
         return True

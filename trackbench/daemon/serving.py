@@ -313,6 +313,8 @@ def _copy(conn, listener, request, fds, path):
             conn.sendall(f"refused: {e}\n".encode())
         except SystemExit as e:
             code = e.code if isinstance(e.code, int) else int(e.code is not None)
+            if isinstance(e.code, str):   # as the interpreter says it
+                print(e.code, file=sys.stderr)
         except BaseException:  # noqa: BLE001  (whatever it was, the command hears a status)
             traceback.print_exc()
         finally:
