@@ -25,3 +25,12 @@ def single_threaded_libraries(env=None):
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
         env.setdefault(var, "1")
     env.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
+
+
+def threads():
+    """This process's threads, any kind (numba's, BLAS', Python's): a process may fork safely
+    with one only. None where the system does not say (no /proc)."""
+    try:
+        return len(os.listdir("/proc/self/task"))
+    except OSError:
+        return None

@@ -23,13 +23,15 @@ import time
 import traceback
 from pathlib import Path
 
+from ..startup import threads as thread_count
+from ..study.warming import TINY
+
 IDLE = float(os.environ.get("TRACKBENCH_DAEMON_IDLE", 900.0))   # s without a command, then it leaves
 TICK = 0.5      # s: how often it looks at its socket file (removed: it leaves) and its copies
 LOOK = 5.0      # s: how often it looks at the package's sources and the libraries (5 ms a look)
 MAX_REQUEST = 1 << 20   # bytes
 # the kinds of model whose kernels a daemon holds (where numba's cache has them), as scenario dicts
 KINDS = ({}, {"track": {"layout": "closed"}, "preset": "damped", "drive": {"kind": "speed"}})
-TINY = {"duration": 1e-3, "output_interval": 1e-3}
 # what rerun imports that starts no thread (a third of its import): loaded here, once; with
 # the progress display and the command line's conversion of values (pydantic), loaded late
 RERUN_LIBRARIES = ("psutil", "PIL.Image", "attr", "attrs", "typing_extensions", "colorsys", "asyncio")
@@ -47,7 +49,7 @@ def main(path, code):
     if stamp(paths) != code:
         return
     left = _preload()   # an exception leaves the start's mark: no new start for a minute
-    threads = _threads()
+    threads = thread_count()
     if threads != 1:
         Path(unusable(Path(path))).write_text(f"{threads} threads after loading the libraries "
                                               "(a process that forks needs one)\n")
@@ -57,10 +59,6 @@ def main(path, code):
     _describe(path)
     Path(starting(Path(path))).unlink(missing_ok=True)
     _serve(listener, path, inode, left, paths, code)
-
-
-def _threads():
-    return len(os.listdir("/proc/self/task"))
 
 
 def _preload():
@@ -200,7 +198,7 @@ class _Idle:
                 return True
         if self.left and self.served:
             self.served, self.left = False, warm_kinds(self.left)
-            return _threads() != 1   # it could no longer fork safely
+            return thread_count() != 1   # it could no longer fork safely
         return False
 
 

@@ -25,6 +25,8 @@ never forked.
 
 import os
 
+from trackbench.startup import threads
+
 THREADS_AT_FORK = None
 PARENT = os.getppid()   # the command that started the server
 
@@ -34,13 +36,6 @@ def _orphaned():
     instead of loading for nobody."""
     if os.getppid() != PARENT:
         os._exit(0)
-
-
-def _threads():
-    try:
-        return len(os.listdir("/proc/self/task"))
-    except OSError:
-        return None
 
 
 def warm():
@@ -75,9 +70,9 @@ def _kinds():
     import json
 
     import trackbench
+    from trackbench.study.warming import TINY as short
     from trackbench.study.warming import WARM
     spec = json.loads(os.environ.get(WARM) or "{}")
-    short = {"duration": 1e-3, "output_interval": 1e-3}
     kinds = _announced(spec["file"]) if spec.get("file") else spec.get("scenarios") or [None]
     for d in kinds:
         try:
@@ -158,4 +153,4 @@ try:
     warm()
 except Exception:  # noqa: BLE001  (warming is an optimisation only)
     pass
-THREADS_AT_FORK = _threads()
+THREADS_AT_FORK = threads()

@@ -10,13 +10,15 @@ server waits for after its imports."""
 
 import json
 import os
+import weakref
 from pathlib import Path
 
-from ..startup import single_threaded_libraries
+from ..startup import single_threaded_libraries, threads
 
 WARM = "TRACKBENCH_WARM"    # the server's spec (JSON): {"scenarios": [...]} or {"file": path}; "flag"
 MAX_WARM = 4
 LATER = "later"             # start_workers(warm=LATER): the kinds come through warm_file()
+TINY = {"duration": 1e-3, "output_interval": 1e-3}   # the run that loads a kind's kernels
 
 
 def warm_kinds(scenarios):
@@ -85,6 +87,7 @@ PRELOAD = "trackbench.study.preload"
 
 WARM_PROCESS = False   # True in the daemon's copy of itself (daemon/serving.py): it is warm
 _POOL = []             # the pool forked from it at the command's start (start_workers)
+_FORKED = weakref.WeakSet()   # the pools forked so (give_back keeps them between a search's waves)
 INHERITED = []         # descriptors of the copy its forked workers close (the command's socket)
 
 
@@ -112,7 +115,7 @@ def start_workers(executor="local", scheduler=None, warm=None, workers=None):
     single_threaded_libraries()
     if _POOL:
         return
-    if WARM_PROCESS and executor == "local" and not scheduler and workers and _one_thread():
+    if WARM_PROCESS and executor == "local" and not scheduler and workers and threads() == 1:
         import multiprocessing
         _POOL.append(_forked_pool(multiprocessing.get_context("fork"), workers))
         return
@@ -130,20 +133,12 @@ def start_workers(executor="local", scheduler=None, warm=None, workers=None):
         forkserver.ensure_running()
 
 
-def _one_thread():
-    """Has this process one thread (any thread: numba's, BLAS', Python's), so it may fork?"""
-    try:
-        return len(os.listdir("/proc/self/task")) == 1
-    except OSError:
-        return False
-
-
 def _forked_pool(ctx, workers):
     from concurrent.futures import ProcessPoolExecutor
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_forked_worker,
                                initargs=(os.getpid(),))
     pool.submit(int)   # a fork pool forks all its workers at its first task: now (not waited for)
-    pool.trackbench_forked = True
+    _FORKED.add(pool)
     return pool
 
 
@@ -180,7 +175,7 @@ def take_pool(workers):
 def give_back(pool, idle):
     """At the end of a wave: a forked pool left ``idle`` waits for the next wave (a search's);
     any other pool is shut down."""
-    if idle and getattr(pool, "trackbench_forked", False):
+    if idle and pool in _FORKED:
         _POOL.append(pool)
     else:
         pool.shutdown(wait=True, cancel_futures=True)
