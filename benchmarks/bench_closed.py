@@ -30,7 +30,7 @@ def rest():
     """At rest on flat ground: weight against ground force, tensioner against the spans."""
     import importlib
 
-    S = importlib.import_module("trackbench.simulate")
+    S = importlib.import_module("trackbench.run.simulate")
     sc = tb.Scenario.from_dict({**CLOSED, "terrain": {"kind": "flat"}})
     t = time.perf_counter()
     eq = S.equilibrium(sc)
@@ -94,7 +94,7 @@ def _span_moment(ds, sc, rows):
     its own line, forward positive: what the spans hold back against the drive."""
     import json
 
-    from trackbench.output_closed import _span_links
+    from trackbench.outputs.closed import _span_links
 
     cl = json.loads(ds.attrs["closed_layout"])
     sx, sy = cl["sprocket"]

@@ -22,7 +22,7 @@ from numba import njit
 import trackbench as tb
 from trackbench.model.core import indices as L
 from trackbench.model.dynamics.reduced import reduced_rhs
-from trackbench.simulate import Model, build_ground, equilibrium, initial_state
+from trackbench.run.simulate import Model, build_ground, equilibrium, initial_state
 
 REPEATS = 3
 

@@ -107,7 +107,7 @@ def _frames(rrd):
     """Rows of the side view's chassis and of the wheel-force plot in the recording."""
     from rerun.chunk import RrdReader
 
-    from trackbench.replay.entities import E_CHASSIS, E_WHEEL_FY, TIMELINE
+    from trackbench.outputs.recording.entities import E_CHASSIS, E_WHEEL_FY, TIMELINE
     rows = {E_CHASSIS: 0, E_WHEEL_FY: 0}
     for c in RrdReader(rrd).stream().to_chunks():
         if c.entity_path in rows and TIMELINE in c.timeline_names:   # not the static styles

@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 import trackbench as tb
-from trackbench.replay.record import write_recording
+from trackbench.outputs.recording.record import write_recording
 
 TARGET = 0.20
 

@@ -10,8 +10,8 @@ per ground segment would have made 2 GB an array. Prints figures; asserts nothin
 import argparse
 
 import trackbench as tb
-from trackbench.assembly import Model, equilibrium
-from trackbench.simulate import build_ground
+from trackbench.run.assemble import Model, equilibrium
+from trackbench.run.simulate import build_ground
 
 BASE = {"preset": "damped", "track.layout": "closed", "drive.kind": "speed", "contact.friction": 0.6,
         "speed": 5.0, "duration": 2.0, "output_interval": 1e-3}

@@ -16,7 +16,7 @@ from bench_closed import STEP
 from side_by_side import best_walls
 
 import trackbench as tb
-from trackbench.traction import pressure_effect, run_soil, steady, wong
+from trackbench.outputs.metrics.traction import pressure_effect, run_soil, steady, wong
 
 REPEATS = 3
 # bench_closed.py's step() run (the paper's step, 10 m/s, speed drive) on LETE sand

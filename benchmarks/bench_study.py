@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
 # the commands run this checkout's trackbench
 os.environ["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
 sys.path.insert(0, str(REPO))
@@ -152,7 +152,7 @@ def folder_bytes(run):
 
 
 def as_before(src, dst):
-    """A copy of the study folder ``src`` whose timeseries.nc are written as before trackbench.storage
+    """A copy of the study folder ``src`` whose timeseries.nc are written as before storage.py
     (xarray's to_netcdf, uncompressed): the yardstick for size and reading time."""
     import xarray as xr
 
@@ -397,7 +397,8 @@ def part_big(cwd, n=1000, repeat=5):
 def part_reading(out, repeat):
     """write_summary and open_study_dataset on a study folder, in this process, median of ``repeat``."""
     import trackbench as tb
-    from trackbench.study.summary import _study_of, write_summary
+    from trackbench.study.read.folder import _study_of
+    from trackbench.study.read.summary import write_summary
 
     study, summary, opened, first = _study_of(out), [], [], []
     for _ in range(repeat):

@@ -29,7 +29,7 @@ from trackbench.solvers.imex.ark_tableau import ARK_TABLEAUS
 from trackbench.solvers.registry import run_function
 from trackbench.solvers.rk.tableau import TABLEAUS
 
-S = importlib.import_module("trackbench.simulate")
+S = importlib.import_module("trackbench.run.simulate")
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6,
           "drive.kind": "speed", "drive.target": 10.0}
 GROUND_REACH = 0.05   # m: a pin this close above the ground's height under it counts as on it

@@ -52,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 import trackbench as tb
-from trackbench import quantities
+from trackbench.outputs import quantities
 
 REFERENCE = {"method": "dopri5", "tolerance": 1e-11}
 TOLERANCES = (1e-7, 1e-8, 1e-9)

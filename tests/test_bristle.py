@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench.assembly import Model, equilibrium, initial_state
 from trackbench.model.core import indices as L
 from trackbench.model.ground.terrain import build_ground
-from trackbench.quantities import SUMMARY, values
+from trackbench.outputs.quantities import SUMMARY, values
+from trackbench.run.assemble import Model, equilibrium, initial_state
 
 K, C, F_MAX = 2e7, 4e4, 2e4
 DRIVEN = {

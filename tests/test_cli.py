@@ -9,7 +9,7 @@ HEAVY = ("numba", "xarray", "pandas", "rerun", "matplotlib", "dask")
 CODE = """
 import sys
 from typer.testing import CliRunner
-from trackbench.cli import app
+from trackbench.cli.app import app
 runner = CliRunner()
 outs = [runner.invoke(app, args) for args in (["--help"], ["params"], ["study", "run", sys.argv[1]],
                                                 ["run", "--set", "speeed=3"])]
@@ -36,7 +36,7 @@ def test_run_that_cannot_start_says_why_in_one_line(tmp_path):
     it would sink, exit code 1, nothing written."""
     from typer.testing import CliRunner
 
-    from trackbench.cli import app
+    from trackbench.cli.app import app
 
     out = tmp_path / "out"
     r = CliRunner().invoke(
@@ -70,7 +70,7 @@ def test_validating_a_study_of_the_paper_layout_loads_no_compiler():
     """The coordinator of `study run` and `study status` validate every run: with the paper's
     layout that needs no numba (the workers' server loads it meanwhile)."""
     code = (
-        "import sys; from trackbench.study.spec import load_study; s = load_study(sys.argv[1]); "
+        "import sys; from trackbench.study.spec.study_file import load_study; s = load_study(sys.argv[1]); "
         "print(len(s.runs), sorted(m for m in %r if m in sys.modules))" % (HEAVY,)
     )
     out = subprocess.run([sys.executable, "-c", code, "studies/speed_sweep.toml"], capture_output=True,

@@ -13,12 +13,12 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from trackbench.cli import app
+from trackbench.cli.app import app
 from trackbench.study import StudyError, load_study, store
-from trackbench.study.runner import check_output, manifest
-from trackbench.study.spec import resolved_toml
+from trackbench.study.execute.runner import check_output, manifest
+from trackbench.study.spec.study_file import resolved_toml
 
-CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
 FAST = "duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 
@@ -254,7 +254,7 @@ def test_version_and_help_shows_flags_and_choices():
 
 
 def test_params_lists_each_unit_in_its_own_column():
-    from trackbench.single_run import parameter_table
+    from trackbench.cli.single_run import parameter_table
 
     table = parameter_table().splitlines()
     assert table[0].split() == ["name", "paper", "value", "unit", "allowed"]

@@ -13,10 +13,10 @@ from trackbench.model.core import indices as L
 from trackbench.model.vehicle.drive import drive_torque
 from trackbench.model.vehicle.teeth import profile
 from trackbench.model.vehicle.teeth_jit import pin_on_sprocket
-from trackbench.quantities import accounted_balance
+from trackbench.outputs.quantities import accounted_balance
 from trackbench.scenario import ScenarioError
 
-S = importlib.import_module("trackbench.simulate")
+S = importlib.import_module("trackbench.run.simulate")
 
 FLAT = {"track.layout": "closed", "terrain": {"kind": "flat"}}
 
@@ -274,7 +274,7 @@ def test_drive_torque_peak_stays_at_its_limit():
     """The PI drive's integral ramps the torque into drive.torque_limit: the summary's peak is
     the limit, not a parabola's vertex above the corner (it read 20.000128 kN m here, and up to
     103 kN m against a 100 kN m limit in the drawbar study)."""
-    from trackbench.output import summary_numbers
+    from trackbench.outputs.dataset import summary_numbers
 
     sc = tb.Scenario.from_dict(
         {
@@ -344,7 +344,7 @@ def test_parked_load_below_mu_w_sticks_with_bristles_and_creeps_with_the_regular
 def test_paper_step_with_the_closed_track():
     """The paper's step at 10 m/s with the closed layout and the speed drive: completes,
     sprocket torque and tensioner force peaks in the summary."""
-    from trackbench.output import summary_numbers
+    from trackbench.outputs.dataset import summary_numbers
 
     ds = tb.simulate(tb.Scenario.from_dict({**DRIVEN, "drive.kind": "speed"}))
     assert ds.attrs["status"] == "completed"
@@ -352,7 +352,7 @@ def test_paper_step_with_the_closed_track():
     assert s["peak_sprocket_torque_kN m"] > 0.0 and s["peak_idler_force_kN"] > 100.0
     assert float(ds.first_contact_time) == pytest.approx(0.0568, abs=3e-3)
     assert float(abs(ds.energy_residual).max()) < 1e-6
-    from trackbench.single_run import format_summary  # the drive's work is not a balance error
+    from trackbench.cli.single_run import format_summary  # the drive's work is not a balance error
 
     line = next(x for x in format_summary(ds).splitlines() if "balance" in x)
     assert "- drive work" in line and float(line.split("work")[1].split("%")[0]) < 1.0

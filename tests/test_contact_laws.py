@@ -8,7 +8,7 @@ from drop import drop, restitution_law_closed_form, viscous_closed_form
 
 import trackbench as tb
 from trackbench.model.contact.laws import DAMPINGS, damping_ratio_for_restitution, restitution_factor
-from trackbench.presets import PAD_RESTITUTION
+from trackbench.scenario.presets import PAD_RESTITUTION
 
 E = (0.2, 0.5, 0.75, 0.9)
 
@@ -43,7 +43,7 @@ def test_no_damping_is_elastic_and_force_never_pulls():
 def test_power_law_vehicle_starts_from_equilibrium(k):
     """A power law has no stiffness at zero compression, where the equilibrium's Newton
     iteration starts: it is reached by continuation from the linear law."""
-    from trackbench.simulate import equilibrium
+    from trackbench.run.simulate import equilibrium
 
     sc = tb.Scenario.paper(
         **{

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench.simulate import equilibrium
+from trackbench.run.simulate import equilibrium
 
 WEIGHT = (20000 + 5 * 300 + 29 * 20) * 9.81
 
@@ -116,7 +116,7 @@ def test_neighbour_lists_equal_full_search(paper_run):
     candidate the forces are identical."""
     from trackbench.model.core import indices as L
     from trackbench.model.dynamics.reduced import reduced_rhs
-    from trackbench.simulate import Model, build_ground
+    from trackbench.run.simulate import Model, build_ground
 
     sc = tb.Scenario.paper()
     eq = equilibrium(sc)

@@ -10,8 +10,8 @@ import pytest
 import trackbench as tb
 from trackbench.model.core import indices as L
 from trackbench.model.vehicle.drive import drawbar_on_chassis, held_speed
+from trackbench.outputs.metrics.traction import pressure_effect, run_soil, steady, wong
 from trackbench.scenario import ScenarioError
-from trackbench.traction import pressure_effect, run_soil, steady, wong
 
 CLOSED = {"track.layout": "closed"}
 
@@ -206,7 +206,7 @@ def test_study_plot_draws_drawbar_pull_against_slip(tmp_path):
     pytest.importorskip("matplotlib")
     import pandas as pd
 
-    from trackbench.replay.plots import plot_study
+    from trackbench.figures.plots import plot_study
 
     rows = []
     for k, (slip, pull) in enumerate(((0.1, 1.2e5), (0.3, 1.3e5))):
@@ -225,7 +225,7 @@ def test_study_plot_leaves_out_drawbar_pull_without_a_drawbar(tmp_path):
     pytest.importorskip("matplotlib")
     import pandas as pd
 
-    from trackbench.replay.plots import plot_study
+    from trackbench.figures.plots import plot_study
 
     rows = []
     for k, (speed, slip, pull) in enumerate(((3.0, 0.02, -100.0), (6.0, 0.04, 2.6e3))):

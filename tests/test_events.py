@@ -14,7 +14,7 @@ from trackbench.model.core import indices as L
 from trackbench.model.core.bundles import EventWork
 from trackbench.model.dynamics.reduced import reduced_rhs
 from trackbench.model.vehicle.kinematics import place
-from trackbench.simulate import Model, build_ground, equilibrium
+from trackbench.run.simulate import Model, build_ground, equilibrium
 from trackbench.solvers.common.events import _gap_end
 
 GROUND_KINDS = (L.K_CORNER_LINK, L.K_CORNER_PIN, L.K_PIN_GROUND)
@@ -100,7 +100,7 @@ def test_closed_event_contact_decision_equals_the_kernels():
     from trackbench.model.core.bundles import event_arrays
     from trackbench.model.dynamics.closed_track_jit import closed_rhs, place_closed
     from trackbench.model.vehicle.teeth_jit import tooth_shape
-    from trackbench.simulate import initial_state
+    from trackbench.run.simulate import initial_state
     from trackbench.solvers.common.events import _teeth_gap
 
     sc = tb.Scenario.from_dict({"track.layout": "closed"})

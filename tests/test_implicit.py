@@ -13,7 +13,7 @@ from trackbench.model.dynamics.rhs import rhs
 from trackbench.solvers.common.pin_jacobian import SQRT_EPS, jacobian_work, pin_jacobian, ring_colours
 from trackbench.solvers.registry import run_function
 
-S = importlib.import_module("trackbench.simulate")
+S = importlib.import_module("trackbench.run.simulate")
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6,
           "drive.kind": "speed", "drive.target": 10.0}
 IMPLICIT = ("ark548l2sa", "ark436l2sa")

@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from trackbench.atomic import atomic_path
+from trackbench.outputs.files.atomic import atomic_path
 
 
 def test_failed_writer_leaves_nothing(tmp_path):

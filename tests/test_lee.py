@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench.output import summary_numbers
-from trackbench.simulate import equilibrium
+from trackbench.outputs.dataset import summary_numbers
+from trackbench.run.simulate import equilibrium
 from trackbench.solvers.lee.lee_iter import accel_matrix
 from trackbench.solvers.lee.rkn_tableau import RKN64, NystromPair
 

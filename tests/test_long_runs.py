@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import trackbench as tb
+from trackbench.outputs.files.storage import frame_step
 from trackbench.solvers.base import control
-from trackbench.storage import frame_step
 
 FLAT = {"terrain": {"kind": "flat"}, "duration": 0.2}
 
@@ -82,7 +82,7 @@ def test_bad_rates_are_one_line_errors(bad):
 
 
 def _prepared(scenario):
-    from trackbench.simulate import prepare
+    from trackbench.run.simulate import prepare
     return prepare(scenario)
 
 
@@ -120,7 +120,7 @@ def long_flat():
 def test_a_streamed_file_reads_back_as_the_run(long_flat, tmp_path):
     import xarray as xr
 
-    from trackbench.stream import stream_run, streamable
+    from trackbench.run.stream import stream_run, streamable
     assert streamable(long_flat) and not streamable(long_flat, "compact")
     assert not streamable(tb.Scenario.paper(duration=0.2))   # one chunk: built in memory
     path, ok = stream_run(long_flat, tmp_path / "run.nc", tmp_path / "run.failed.nc")
@@ -136,7 +136,7 @@ def test_a_streamed_file_reads_back_as_the_run(long_flat, tmp_path):
 
 
 def test_a_stream_that_stops_leaves_no_file(long_flat, tmp_path, monkeypatch):
-    import trackbench.stream as S
+    import trackbench.run.stream as S
     calls = []
 
     def broken(self, ds):   # the second chunk never arrives (as a run killed halfway)
@@ -153,7 +153,7 @@ def test_a_stream_that_stops_leaves_no_file(long_flat, tmp_path, monkeypatch):
 
 
 def test_a_streamed_run_that_fails_is_kept_as_failed(tmp_path):
-    from trackbench.stream import stream_run
+    from trackbench.run.stream import stream_run
     sc = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 5.0, "max_steps": 10_000})
     path, ok = stream_run(sc, tmp_path / "run.nc", tmp_path / "run.failed.nc")
     assert not ok and path.name == "run.failed.nc" and not (tmp_path / "run.nc").exists()
@@ -164,8 +164,8 @@ def test_a_long_recording_is_written_block_by_block(tmp_path):
     the last), in time order."""
     from rerun.chunk import RrdReader
 
-    from trackbench.replay import entities as E
-    from trackbench.replay import record as R
+    from trackbench.outputs.recording import entities as E
+    from trackbench.outputs.recording import record as R
     ds = tb.simulate(tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 9.0}))
     n = ds.sizes["time"]
     assert n > R.RECORD_BLOCK

@@ -6,9 +6,10 @@ import json
 import pandas as pd
 import pytest
 
-from trackbench import output, quantities
-from trackbench.quantities import run_summary
-from trackbench.replay.plots import study_axes
+from trackbench.figures.plots import study_axes
+from trackbench.outputs import dataset as output
+from trackbench.outputs import quantities
+from trackbench.outputs.quantities import run_summary
 
 SI_OF = {"kN": "N", "kN m": "N m", "m/s^2": "m s-2", "m/s": "m s-1", "s": "s", "1": "1", "cm": "m", "%": "1",
          "g": "1", "W": "W", "m/s^1.75": "m s-1.75"}

@@ -10,14 +10,14 @@ from rerun.chunk import RrdReader
 from typer.testing import CliRunner
 
 import trackbench as tb
-from trackbench.cli import app
-from trackbench.output import write_netcdf
-from trackbench.replay import entities as E
-from trackbench.replay import geometry as G
-from trackbench.replay import record as R
-from trackbench.replay import soil_view as S
-from trackbench.replay import view as V
-from trackbench.replay.plots import plot_run, plot_study, study_axes
+from trackbench.cli import view as V
+from trackbench.cli.app import app
+from trackbench.figures.plots import plot_run, plot_study, study_axes
+from trackbench.outputs import geometry as G
+from trackbench.outputs.dataset import write_netcdf
+from trackbench.outputs.recording import entities as E
+from trackbench.outputs.recording import record as R
+from trackbench.outputs.recording import soil_view as S
 
 GEOMETRY = (E.E_CHASSIS, E.E_ARMS, E.E_WHEELS, E.E_LINKS, E.E_PINS, E.E_WHEEL_FORCE, E.E_GROUND_FORCE)
 
@@ -208,7 +208,7 @@ def fake_times(t_end, status="completed", n=200):
 
 
 def test_default_configuration_times_lie_in_the_run():
-    from trackbench.replay.plots import PAPER_TIMES, choose_times, default_times
+    from trackbench.figures.plots import PAPER_TIMES, choose_times, default_times
 
     assert default_times(fake_times(0.5)) == PAPER_TIMES  # the paper's run: its times
     assert default_times(fake_times(1.5)) == pytest.approx((0.5, 1.0, 1.5))  # spread over a long run
@@ -237,7 +237,7 @@ def test_failed_short_run_still_gets_its_figures(step_run, tmp_path):
 def test_configuration_frames_the_vehicle_and_scales_the_arrows(step_run):
     import matplotlib.pyplot as plt
 
-    from trackbench.replay.plots import _arrow_scale, draw_configuration
+    from trackbench.figures.plots import _arrow_scale, draw_configuration
 
     i = int(np.argmax(step_run["wheel_force_y"].values.max(axis=1)))  # the hardest hit on the step
     g = G.side_view(step_run, [i])
@@ -261,7 +261,7 @@ def test_configuration_frames_the_vehicle_and_scales_the_arrows(step_run):
 
 
 def test_run_titles_name_the_run(step_run, tmp_path):
-    from trackbench.replay.plots import run_label
+    from trackbench.figures.plots import run_label
 
     d = tmp_path / "speed_sweep" / "runs" / "abcdef0123456789"
     write_netcdf(step_run, d / "timeseries.nc")
@@ -367,7 +367,7 @@ def test_plot_study_one_figure_per_axis(tmp_path):
 
 
 def test_study_axes_have_units_and_readable_values():
-    from trackbench.replay.plots import axis_label, parameter_unit, value_label
+    from trackbench.figures.plots import axis_label, parameter_unit, value_label
 
     assert [
         parameter_unit(k)
@@ -389,7 +389,7 @@ def test_study_axes_have_units_and_readable_values():
 
 
 def test_study_draws_a_line_per_value_of_the_other_axis(tmp_path):
-    from trackbench.replay.plots import _groups
+    from trackbench.figures.plots import _groups
 
     fake_summary(tmp_path / "st")
     df = pd.read_csv(tmp_path / "st" / "summary.csv")
@@ -616,7 +616,7 @@ def test_closed_run_draws_the_drive(closed_run, tmp_path):
 def test_closed_configuration_png(closed_run, tmp_path):
     import matplotlib.image as mpimg
 
-    from trackbench.replay.plots import plot_configuration
+    from trackbench.figures.plots import plot_configuration
 
     path = plot_configuration(closed_run, (0.0, 0.02), tmp_path / "configuration.png")
     assert path.exists() and path.stat().st_size > 20_000
@@ -769,7 +769,7 @@ def test_soil_run_draws_sinkage_and_pull(soil_run, tmp_path):
 def test_soil_configuration_png_shows_the_rut(soil_run, step_run, tmp_path):
     import matplotlib.image as mpimg
 
-    from trackbench.replay.plots import SOIL_DENT, plot_configuration
+    from trackbench.figures.plots import SOIL_DENT, plot_configuration
 
     def share(path):
         img = mpimg.imread(path)[..., :3]
@@ -782,7 +782,7 @@ def test_soil_configuration_png_shows_the_rut(soil_run, step_run, tmp_path):
 
 
 def test_plotting_a_file_that_is_not_a_run_says_so_in_one_line(tmp_path):
-    from trackbench.replay.plots import plot_run
+    from trackbench.figures.plots import plot_run
 
     junk = tmp_path / "junk.nc"
     junk.write_text("not netCDF")
@@ -800,7 +800,7 @@ def test_a_soil_study_figure_has_panels_for_sinkage_pull_and_slip():
     rigid-ground study keeps the two force panels."""
     import pandas as pd
 
-    from trackbench.replay.study_figures import _panels, _what
+    from trackbench.figures.study_figures import _panels, _what
 
     df = pd.DataFrame(
         {
@@ -826,7 +826,7 @@ def test_a_closed_track_study_figure_has_a_sprocket_torque_panel():
     among the peak forces (kN)."""
     import pandas as pd
 
-    from trackbench.replay.study_figures import _panels, _what
+    from trackbench.figures.study_figures import _panels, _what
 
     df = pd.DataFrame(
         {"peak_wheel1_force_y": [1e5], "peak_idler_force": [1.5e5], "peak_sprocket_torque": [1.4e4]}
@@ -841,7 +841,7 @@ def test_study_figures_are_titled_by_the_study_name_not_its_folder(tmp_path):
     """`study run --output elsewhere` names the folder; the figures keep the study's name."""
     import json
 
-    from trackbench.replay.study_figures import _study_name
+    from trackbench.figures.study_figures import _study_name
 
     (tmp_path / "elsewhere").mkdir()
     src = tmp_path / "elsewhere" / "summary.csv"

@@ -12,7 +12,7 @@ import hashlib, sys
 import numpy as np
 import trackbench as tb
 if sys.argv[1] == "rhs-first":   # load the right-hand side on its own before the time loop
-    from trackbench.simulate import Model, build_ground, equilibrium, initial_state
+    from trackbench.run.simulate import Model, build_ground, equilibrium, initial_state
     from trackbench.model.dynamics.reduced import reduced_rhs
     from trackbench.model.core import indices as L
     sc = tb.Scenario.paper()

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import scipy.signal as ss
 
-from trackbench import ride_metrics as rm
+from trackbench.outputs.metrics import ride as rm
 
 DT = 1e-4
 WK_CHECK = {1.0: 0.4825, 2.0: 0.5314, 4.0: 0.9672, 8.0: 1.0364, 16.0: 0.7687, 31.5: 0.4048}

@@ -9,9 +9,14 @@ import numpy as np
 import pytest
 
 import trackbench as tb
-from trackbench import quantities
 from trackbench.model.ground.rough import SPACING, random_profile
-from trackbench.ride_metrics import absorbed_power, peak_seat_acceleration_g, vdv, weighted_rms_acceleration
+from trackbench.outputs import quantities
+from trackbench.outputs.metrics.ride import (
+    absorbed_power,
+    peak_seat_acceleration_g,
+    vdv,
+    weighted_rms_acceleration,
+)
 from trackbench.scenario import ScenarioError
 
 ROUGH = {"kind": "random", "roughness_class": "D", "run_in": 3.0, "seed": 7}
@@ -92,7 +97,7 @@ def test_a_run_on_random_ground_keeps_its_profile(rough_run):
 
 
 def test_the_recording_draws_the_rough_ground(rough_run):
-    from trackbench.replay.geometry import covered_x_range, ground_polyline
+    from trackbench.outputs.geometry import covered_x_range, ground_polyline
 
     v = ground_polyline(rough_run)
     lo, hi = covered_x_range(rough_run)
@@ -138,7 +143,7 @@ def test_bad_rough_ground_fails_in_one_line(terrain, fragment):
 
 
 def test_a_study_reads_its_profile_beside_the_study_file(tmp_path, monkeypatch):
-    from trackbench.study.spec import load_study
+    from trackbench.study.spec.study_file import load_study
 
     (tmp_path / "courses").mkdir()
     (tmp_path / "courses" / "course.csv").write_text("x,height\n0,0\n10,0\n11,0.05\n12,0\n")
@@ -152,9 +157,9 @@ def test_a_study_reads_its_profile_beside_the_study_file(tmp_path, monkeypatch):
 def test_a_long_course_holds_candidate_rows_by_its_length_not_its_square():
     """600 m of rough ground (16,385 segments): the candidate rows hold SEGMENT_CANDIDATES
     segments each (before, as many as the ground has: 2 GB an array), and the run goes."""
-    from trackbench.assembly import Model, equilibrium
     from trackbench.model.core.indices import SEGMENT_CANDIDATES
-    from trackbench.simulate import build_ground
+    from trackbench.run.assemble import Model, equilibrium
+    from trackbench.run.simulate import build_ground
 
     sc = tb.Scenario.paper(duration=0.05, terrain={**ROUGH, "length": 600.0})
     eq = equilibrium(sc)
@@ -187,8 +192,8 @@ def test_restitution_laws_on_a_long_ground_are_refused_in_one_line():
 def test_a_long_run_is_replayed_following_the_chassis(tmp_path, rough_run):
     """A run covering more than 20 m of ground is seen in a window about the chassis, the
     world moved under it frame by frame; a short run whole, as before."""
-    from trackbench.replay.geometry import follow_window
-    from trackbench.replay.record import write_recording
+    from trackbench.outputs.geometry import follow_window
+    from trackbench.outputs.recording.record import write_recording
 
     assert follow_window(rough_run) is None                      # 8 m covered
     ds = tb.simulate(tb.Scenario.paper(duration=2.5, terrain={"kind": "flat"}))   # 25 m

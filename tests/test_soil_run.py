@@ -10,7 +10,7 @@ import trackbench as tb
 from trackbench.model.ground.soil import SOILS, bekker_pressure, static_sinkage
 from trackbench.scenario import ScenarioError
 
-S = importlib.import_module("trackbench.simulate")
+S = importlib.import_module("trackbench.run.simulate")
 
 
 @pytest.mark.parametrize("name", sorted(SOILS))
@@ -109,7 +109,7 @@ def test_driven_on_sand_outputs_and_energy(driven_on_sand):
     assert float(abs(ds.energy_residual).max()) < 1e-6
     # the work the soil takes counts as dissipated: the paper's balance with it, the tensioner's
     # spring and the drive's work closes to the integration's accuracy
-    from trackbench.quantities import accounted_balance
+    from trackbench.outputs.quantities import accounted_balance
 
     assert float(ds.energy_dissipated[-1]) > 0.0
     assert np.abs(accounted_balance(ds)[0]).max() < 1e-6
@@ -200,7 +200,7 @@ def test_soil_peaks_agree_over_tolerances_and_a_nudge():
     peaks do not depend on where the steps happened to end: the default tolerance, ten times
     tighter and a 1e-9 m nudge of the free pins agree within 1 % (with the memory moved from the
     steps' end states alone: min chassis ay 6.3 % apart)."""
-    from trackbench.quantities import quantity_of, values
+    from trackbench.outputs.quantities import quantity_of, values
 
     runs = [{}, {"tolerance": 1e-10}, {"perturbation": 1e-9, "seed": 1}]
     peaks = []

@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from trackbench import storage
-from trackbench.output import write_netcdf
+from trackbench.outputs.dataset import write_netcdf
+from trackbench.outputs.files import storage
 from trackbench.study import StudyError, load_study, run_study, store
 
 REPO = Path(__file__).resolve().parents[1]
@@ -20,7 +20,7 @@ REPO = Path(__file__).resolve().parents[1]
 
 @pytest.fixture(scope="module")
 def files(paper_run, tmp_path_factory):
-    """paper_step written by xarray itself (the writer before trackbench.storage), full and compact."""
+    """paper_step written by xarray itself (the writer before outputs/files/storage.py), full and compact."""
     d = tmp_path_factory.mktemp("storage")
     paper_run.to_netcdf(
         d / "xarray.nc", engine="netcdf4", encoding={k: {"_FillValue": None} for k in paper_run.coords}
@@ -98,7 +98,7 @@ def test_bad_storage_names_the_value_and_what_is_allowed(tmp_path):
         [
             sys.executable,
             "-c",
-            "from trackbench.cli import main; main()",
+            "from trackbench.cli.app import main; main()",
             "run",
             "--storage",
             "x",
@@ -143,7 +143,7 @@ def test_run_command_with_compact_storage(tmp_path):
         [
             sys.executable,
             "-c",
-            "from trackbench.cli import main; main()",
+            "from trackbench.cli.app import main; main()",
             "run",
             "--storage",
             "compact",

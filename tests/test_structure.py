@@ -108,7 +108,7 @@ PLAIN = [
     "trackbench.model.core.indices",
     "trackbench.scenario",
     "trackbench.solvers.registry",
-    "trackbench.ride_metrics",
+    "trackbench.outputs.metrics.ride",
 ]
 
 

@@ -11,9 +11,11 @@ import xarray as xr
 from typer.testing import CliRunner
 
 import trackbench as tb
-from trackbench.cli import app
-from trackbench.study import load_study, run_study, runner, store
-from trackbench.study.summary import _STACK, write_summary
+from trackbench.cli.app import app
+from trackbench.study import load_study, run_study, store
+from trackbench.study.execute import runner
+from trackbench.study.read.opening import _STACK
+from trackbench.study.read.summary import write_summary
 
 N = 300
 
@@ -106,7 +108,7 @@ def _durations(tmp_path, intervals=(0.001, 0.001)):
 def test_runs_stacked_from_their_headers_are_xarrays_concatenation(tmp_path):
     """The lazy stacking gives what xarray's outer concatenation of the loaded files gives,
     a shorter run NaN-padded; a selection reads only the runs it selects."""
-    from trackbench.study.stacked import open_stacked
+    from trackbench.study.read.stacked import open_stacked
 
     files = _durations(tmp_path)
     lazy = open_stacked(files, chunk=False)
@@ -122,7 +124,7 @@ def test_runs_stacked_from_their_headers_are_xarrays_concatenation(tmp_path):
 def test_runs_that_do_not_line_up_are_left_to_xarray(tmp_path):
     """Runs of different output intervals do not share a time axis: open_stacked says so (None)
     and open_study_dataset aligns them with xarray on the union of their times."""
-    from trackbench.study.stacked import open_stacked
+    from trackbench.study.read.stacked import open_stacked
 
     files = _durations(tmp_path, intervals=(0.001, 0.002))
     assert open_stacked(files) is None
@@ -135,7 +137,7 @@ def test_the_coordinator_checks_a_runs_file_by_its_signature_and_size(tmp_path):
     """A completed run's timeseries.nc is taken when it starts as netCDF-4 and has the size the
     worker reported; the same size of other bytes is not; a record without the size (a worker
     of an earlier version) has its file opened."""
-    from trackbench.study import executors
+    from trackbench.study.execute import executors
 
     (tmp_path / "c.toml").write_text('[study]\nname = "c"\n[scenario]\nduration = 0.01\n'
                                      "record = { enabled = false }\n")

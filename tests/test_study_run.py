@@ -16,10 +16,10 @@ import xarray as xr
 
 import trackbench as tb
 from trackbench.study import StudyLocked, load_study, run_study, store
-from trackbench.study.summary import write_summary
+from trackbench.study.read.summary import write_summary
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
 FAST = "duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 
@@ -146,7 +146,7 @@ def test_force_reruns_everything(tmp_path):
 def test_runs_of_an_edited_grid_are_kept_and_said(tmp_path):
     """A grid edited (or a new model version: run ids include it) leaves run folders that belong
     to no run of the study: kept, not in the summary, and the report says how many."""
-    from trackbench.study.runner import report
+    from trackbench.study.execute.runner import report
 
     p = tmp_path / "g.toml"
     p.write_text(f"[study]\nname = 'g'\n[scenario]\n{FAST}[grid]\nspeed = [6.0, 9.0]\n")
@@ -305,7 +305,7 @@ def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
     assert np.isnan(cy[0, -5:]).all() and not np.isnan(cy[1]).any() and not np.isnan(cy[0, :31]).any()
     assert list(ds.duration.values) == [0.03, 0.05]
     # without dask (the README's plain install) the same dataset, read into memory
-    from trackbench.study import summary
+    from trackbench.study.read import summary
 
     monkeypatch.setattr(summary, "_have_dask", lambda: False)
     eager = tb.open_study_dataset(tmp_path / "a")
@@ -321,16 +321,16 @@ def test_recording_failure_is_noted_not_fatal(tmp_path, monkeypatch):
     """A recording writer that raises: the run completes and run.json says why."""
     import types
 
-    from trackbench.study.executors import execute_run
+    from trackbench.study.execute.executors import execute_run
 
-    mod = types.ModuleType("trackbench.replay.record")
+    mod = types.ModuleType("trackbench.outputs.recording.record")
 
     def boom(ds, path, every=1, signal_every=1):
         Path(path).write_text("partial")
         raise RuntimeError("disk full")
 
     mod.write_recording = boom
-    monkeypatch.setitem(sys.modules, "trackbench.replay.record", mod)
+    monkeypatch.setitem(sys.modules, "trackbench.outputs.recording.record", mod)
     s = load_study(
         _write(tmp_path, "[scenario]\nduration = 0.02\noutput_interval = 0.001\n"), output=tmp_path / "o"
     )
@@ -362,7 +362,7 @@ def _write(tmp_path, text):
 def test_progress_is_a_live_bar_on_a_terminal_and_one_line_per_run_otherwise():
     import io
 
-    from trackbench.study.progress import StudyProgress
+    from trackbench.study.execute.progress import StudyProgress
 
     runs = [
         {"run_id": "a1", "status": "completed"},
@@ -399,7 +399,7 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
     import io
     import json
 
-    from trackbench.study.progress import StudyProgress
+    from trackbench.study.execute.progress import StudyProgress
 
     flag = tmp_path / "flag.json"
     flag.write_text(json.dumps({"compiling": True, "seconds": 0.0}))
@@ -418,7 +418,7 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
 
 
 def test_one_warm_scenario_per_kind_of_compiled_model():
-    from trackbench.study.warming import warm_kinds
+    from trackbench.warm.forkserver import warm_kinds
 
     paper = tb.Scenario.paper().to_dict()
     runs = [
@@ -439,8 +439,8 @@ def test_one_warm_scenario_per_kind_of_compiled_model():
 def test_workers_are_forks_of_a_single_threaded_preloaded_server():
     """The pool's workers come from the fork server: the kernels already loaded there, which had
     one thread when it forked (trackbench/study/preload.py says why that makes forking safe)."""
-    from trackbench.study import executors
-    from trackbench.study.preload import facts
+    from trackbench.study.execute import executors
+    from trackbench.warm.preload import facts
 
     pool = executors._new_pool(2)
     try:
@@ -454,9 +454,9 @@ def test_workers_are_forks_of_a_single_threaded_preloaded_server():
 
 WARM_LATER = """
 import json, sys
-from trackbench.study import executors
-from trackbench.study.preload import facts
-from trackbench.study.warming import LATER, announce, forget
+from trackbench.study.execute import executors
+from trackbench.warm.preload import facts
+from trackbench.warm.forkserver import LATER, announce, forget
 executors.start_workers(warm=LATER)
 announce(json.loads(sys.argv[1]))
 pool = executors._new_pool(1)
@@ -480,9 +480,9 @@ def test_the_server_warms_what_the_command_announces_after_it_started(announced)
 
 STOPPED = """
 import json
-from trackbench.study import executors
-from trackbench.study.preload import facts
-from trackbench.study.warming import LATER, stop_server
+from trackbench.study.execute import executors
+from trackbench.warm.preload import facts
+from trackbench.warm.forkserver import LATER, stop_server
 executors.start_workers(warm=LATER)
 stop_server()   # bad input found after the start: nothing will be announced
 pool = executors._new_pool(1)

@@ -14,11 +14,12 @@ import pandas as pd
 import pytest
 
 import trackbench as tb
-from trackbench.study import executors, run_study
-from trackbench.study import search as S
-from trackbench.study.spec import StudyError, expand_range, load_study, resolved_toml
+from trackbench.study import run_study
+from trackbench.study.execute import executors
+from trackbench.study.spec import search as S
+from trackbench.study.spec.study_file import StudyError, expand_range, load_study, resolved_toml
 
-CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
 
 
 def spec(**kw):
@@ -120,7 +121,7 @@ def test_a_failed_run_with_a_maximum_already_over_the_limit_counts_as_over(monke
     seat's 2.8 g); under the limit, or a mean, a failed run stays unknown."""
     from types import SimpleNamespace
 
-    from trackbench.study import limits
+    from trackbench.study.read import limits
     recs = {"over": {"status": "failed", "results": {"peak_q": 3.0, "mean_q": 3.0}},
             "under": {"status": "failed", "results": {"peak_q": 1.0}}}
     monkeypatch.setattr(limits.store, "read_run", lambda output, run_id: recs[run_id])
@@ -136,7 +137,7 @@ def test_a_search_study_with_only_decided_failures_exits_cleanly():
     exit; a failure under the limit (unknown) still is one."""
     from types import SimpleNamespace
 
-    from trackbench.study.runner import Outcome
+    from trackbench.study.execute.runner import Outcome
     study = SimpleNamespace(search=spec(quantity="peak_q", limit=2.0), runs=[None] * 3)
     frame = pd.DataFrame({"run_id": ["a", "b", "c"], "status": ["completed", "failed", "completed"],
                           "peak_q": [1.0, 3.0, 2.5]})
@@ -330,7 +331,7 @@ def test_search_status_summary_and_a_second_resume(searched):
 
 
 def test_plot_draws_the_limit_curve_and_names_the_run_at_the_limit(searched, tmp_path):
-    from trackbench.replay.plots import plot_study
+    from trackbench.figures.plots import plot_study
     out = searched[1]
     lim = pd.read_csv(out / "limits.csv")
     summary = pd.read_csv(out / "summary.csv").set_index("run_id")
@@ -365,7 +366,7 @@ def test_open_limits_needs_a_search_and_its_file(tmp_path):
 def test_the_search_line_labels_the_bar_on_a_terminal_and_is_a_line_of_a_log():
     import io
 
-    from trackbench.study.progress import StudyProgress
+    from trackbench.study.execute.progress import StudyProgress
 
     term = io.StringIO()
     p = StudyProgress(0, 10, stream=term, workers=2, terminal=True, line="search: round 1")

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 import trackbench as tb
+from trackbench.cli.single_run import scenario_from_sets
 from trackbench.scenario import ScenarioError
-from trackbench.single_run import scenario_from_sets
-from trackbench.study.spec import load_study
+from trackbench.study.spec.study_file import load_study
 
 
 def test_position_on_the_command_line_replaces_the_default_placement():
@@ -97,7 +97,7 @@ def test_a_points_terrain_starts_without_obstacle_contact():
 
 
 def test_a_run_that_ends_before_the_planned_contact_says_so():
-    from trackbench.single_run import format_summary
+    from trackbench.cli.single_run import format_summary
 
     ds = tb.simulate(tb.Scenario.paper(duration=0.01, output_interval=1e-3))
     line = next(x for x in format_summary(ds).splitlines() if "first obstacle contact" in x)

@@ -7,13 +7,13 @@ _jitcache.configure()  # before any compiled kernel is defined
 
 # the heavy parts (numba, xarray, pandas) load on first use: the command line's help and
 # the validation of scenarios and study files stay fast
+from .run.simulate import simulate  # noqa: E402  (light until called)
 from .scenario import Scenario, ScenarioError  # noqa: E402  (light: no compiler)
-from .simulate import simulate  # noqa: E402  (light until called)
 
 _LAZY = {
-    "open_study": ("study.summary", "open_study"),
-    "open_study_dataset": ("study.summary", "open_study_dataset"),
-    "open_limits": ("study.limits", "open_limits"),
+    "open_study": ("study.read.opening", "open_study"),
+    "open_study_dataset": ("study.read.opening", "open_study_dataset"),
+    "open_limits": ("study.read.opening", "open_limits"),
 }
 
 __all__ = ["Scenario", "ScenarioError", "simulate", "open_study", "open_study_dataset", "open_limits",

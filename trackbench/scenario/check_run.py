@@ -4,7 +4,8 @@ models beyond the paper (coefficients that belong together, what the lee solver 
 import copy
 import math
 
-from ..presets import PRESETS, preset_values
+from trackbench.scenario.presets import PRESETS, preset_values
+
 from . import ScenarioError
 from .check_values import flatten, set_dotted
 from .parameters_table import RIDE_KINDS, RIDE_OUTPUT_INTERVAL, paper_step

@@ -3,11 +3,12 @@ allowed values and unit. Data only; the checks that read it sit beside it (check
 
 import math
 
+from trackbench.scenario.presets import PRESETS
+
 from ..model.contact.laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
 from ..model.core.indices import DRIVES
 from ..model.ground.rough import CLASSES
 from ..model.vehicle.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle
-from ..presets import PRESETS
 from ..solvers.registry import METHODS
 from ..solvers.registry import SOLVERS as _REGISTRY
 

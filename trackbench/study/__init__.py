@@ -1,9 +1,12 @@
 """Parameter studies: TOML grids run in parallel, kept as netCDF, resumable, summarised with pandas.
-The parts load on first use (study file validation needs none of the heavy libraries)."""
+What a study is (spec/), how it runs (execute/), how it is read (read/), and its results
+folder's layout (store.py). The parts load on first use (study file validation needs none of
+the heavy libraries)."""
 
 _LAZY = {
-    "run_study": "runner", "StudyError": "spec", "load_study": "spec", "StudyLocked": "store",
-    "open_run": "summary", "open_limits": "limits", "open_study": "summary", "open_study_dataset": "summary",
+    "run_study": "execute.runner", "StudyError": "spec.rules", "load_study": "spec.study_file",
+    "StudyLocked": "store", "open_run": "read.opening", "open_limits": "read.opening",
+    "open_study": "read.opening", "open_study_dataset": "read.opening",
 }
 
 __all__ = sorted(_LAZY)

@@ -18,7 +18,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
-from ..atomic import TMP_SUFFIX, atomic_path, tmp_path  # noqa: F401  (tmp_path: the workers' and clean_tmp's)
+from trackbench.outputs.files.atomic import TMP_SUFFIX, atomic_path, tmp_path  # noqa: F401  (tmp_path: the workers' and clean_tmp's)
 
 
 class StudyLocked(RuntimeError):
@@ -46,7 +46,7 @@ def _json_default(x):
 
 def write_timeseries(ds, path, storage="full"):
     """netCDF, atomically (output.write_netcdf), as ``storage`` says (trackbench/storage.py)."""
-    from ..output import write_netcdf
+    from trackbench.outputs.dataset import write_netcdf
     return write_netcdf(ds, path, storage)
 
 

@@ -1,0 +1,368 @@
+"""The trackbench command line (Typer). Commands only: every piece of work lives in the package."""
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+from typer.core import TyperCommand, TyperGroup
+
+
+def _untyped(option):
+    """Typer labels its own --help flag `<bool>`; a flag takes no value, so no label."""
+    if option is not None:
+        option.metavar = ""
+    return option
+
+
+class _Command(TyperCommand):
+    def get_help_option(self, ctx):
+        return _untyped(super().get_help_option(ctx))
+
+
+class _Group(TyperGroup):
+    def get_help_option(self, ctx):
+        return _untyped(super().get_help_option(ctx))
+
+
+app = typer.Typer(add_completion=False, no_args_is_help=True, cls=_Group,
+                  help="Dynamics of high-mobility tracked vehicles (K. Lee, 2000).")
+STORAGE = "full|compact"
+study_app = typer.Typer(no_args_is_help=True, cls=_Group, help="Run and read parameter studies (TOML).")
+app.add_typer(study_app, name="study")
+
+
+def _fail(msg: str, code: int = 2):
+    typer.secho(f"error: {msg}", fg=typer.colors.RED, err=True)
+    raise typer.Exit(code)
+
+
+def _version(value: bool):
+    if value:
+        from trackbench.version import MODEL_VERSION, __version__
+        typer.echo(f"trackbench {__version__} (model version {MODEL_VERSION})")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", metavar="", callback=_version, is_eager=True,
+                                       help="Print the version and exit.")):
+    """Dynamics of high-mobility tracked vehicles (K. Lee, 2000)."""
+
+
+@app.command(cls=_Command)
+def run(
+    set_: List[str] = typer.Option(
+        [],
+        "--set",
+        "-s",
+        metavar="NAME=VALUE",
+        help="Override a parameter by dotted name: --set speed=15 --set terrain.height=0.15",
+    ),
+    duration: Optional[float] = typer.Option(
+        None, help="Simulated time (s); default: the scenario's (0.5 s)."
+    ),
+    out: Path = typer.Option(
+        Path("out"), "--out", "-o", help="Folder for the netCDF file and the recording."
+    ),
+    name: Optional[str] = typer.Option(
+        None, help="Scenario name, used for the file names; default: --set name=..., else paper_step."
+    ),
+    force: bool = typer.Option(
+        False, "--force", metavar="", help="Replace OUT/NAME.nc (and .rrd) if they exist."
+    ),
+    storage: str = typer.Option(
+        "full",
+        metavar=STORAGE,
+        help="full (lossless) or compact (time histories at the resolution "
+        "results_schema.md states, a thinner recording).",
+    ),
+):
+    """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
+    from trackbench.cli.single_run import run_one
+    from trackbench.scenario import ScenarioError
+    from trackbench.status import EquilibriumError
+    try:
+        text, ok = run_one(set_, duration, out, name, force, storage)
+    except ScenarioError as e:
+        _fail(str(e))
+    except EquilibriumError as e:      # no start: nothing written
+        _fail(str(e), 1)
+    typer.echo(text)
+    if not ok:
+        raise typer.Exit(1)
+
+
+@app.command(cls=_Command)
+def params():
+    """List every parameter name with its paper value and what is allowed."""
+    from trackbench.cli.single_run import parameter_table
+    typer.echo(parameter_table())
+
+
+# --- study commands ----------------------------------------------------------------
+
+def _load_study_or_fail(file: Path, output: Optional[Path] = None):
+    from trackbench.study import StudyError, load_study
+    try:
+        return load_study(file, output=output)
+    except StudyError as e:
+        _fail(str(e))
+
+
+def _study_folder_or_fail(path: Path):
+    """A study file or results folder -> (study, its results folder, which exists)."""
+    from trackbench.study import StudyError
+    from trackbench.study.read.folder import study_folder
+    try:
+        return study_folder(path)
+    except StudyError as e:
+        _fail(str(e))
+
+
+@study_app.command("run", cls=_Command)
+def study_run(
+    file: Path = typer.Argument(..., help="Study file (TOML), e.g. studies/speed_sweep.toml."),
+    workers: int = typer.Option(
+        2, "--workers", "-w", help="Worker processes (or dask workers of a LocalCluster)."
+    ),
+    executor: str = typer.Option(
+        "local", metavar="local|dask", help="local (process pool) or dask (dask.distributed)."
+    ),
+    scheduler: Optional[str] = typer.Option(
+        None, help="dask scheduler address, e.g. tcp://host:8786; default: a LocalCluster."
+    ),
+    force: bool = typer.Option(
+        False, "--force", metavar="", help="Rerun every run, also those already completed."
+    ),
+    output: Optional[Path] = typer.Option(
+        None,
+        "--output",
+        "-o",
+        help="Results folder; default: the study's "
+        "\\[study] output, else results/NAME (relative to the current directory).",
+    ),
+    storage: Optional[str] = typer.Option(
+        None,
+        metavar=STORAGE,
+        help="full (lossless) or compact (time histories "
+        "at the resolution results_schema.md states); default: the "
+        "study's \\[study] storage, "
+        "else full. Runs already completed keep their files.",
+    ),
+):
+    """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
+    from trackbench.study.execute.executors import check_arguments
+    from trackbench.warm.forkserver import ForkServerPools, started_early
+    try:
+        check_arguments(workers, executor, scheduler, storage)
+    except ValueError as e:
+        _fail(str(e))
+    try:
+        with started_early(executor, scheduler) as tell:
+            study = _load_study_or_fail(file, output)
+            from trackbench.study import store
+            tell(r.scenario for r in study.runs if force or not store.is_completed(study.output, r.run_id))
+            from trackbench.study.execute.runner import check_output
+            check_output(study)   # a folder that cannot be written, or that holds another study's results
+    except ValueError as e:
+        _fail(str(e))
+    from trackbench.study import StudyError, StudyLocked, run_study
+    from trackbench.study.execute.runner import report
+    try:
+        outcome = run_study(study, workers=workers, executor=executor, scheduler=scheduler, force=force,
+                            storage=storage, pools=ForkServerPools())
+    except (StudyError, ValueError) as e:
+        _fail(str(e))
+    except StudyLocked as e:
+        _fail(str(e), code=3)
+    except RuntimeError as e:  # e.g. the dask scheduler cannot be reached
+        _fail(str(e), code=1)
+    except KeyboardInterrupt:
+        _fail(
+            "interrupted: completed runs are kept; run the same command again to finish the study", code=130
+        )
+    typer.echo(report(outcome))
+    if outcome.problem():
+        _fail(outcome.problem(), code=1)
+
+
+@study_app.command("summary", cls=_Command)
+def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
+    """Print the study's summary table (rebuilt from the runs' run.json; summary files rewritten)."""
+    from trackbench.study.read.summary import format_table, write_summary
+    study, _ = _study_folder_or_fail(file)
+    df, rep = write_summary(study)
+    typer.echo(format_table(df, rep, study.param_names))
+
+
+@study_app.command("status", cls=_Command)
+def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
+    """Show how many runs are done, failed and pending (and how far a [search] is)."""
+    from trackbench.study.execute.runner import count, other_runs, others_note, status_counts
+    from trackbench.study.read.folder import missing_folder
+    study = _study_folder_or_fail(file)[0] if file.is_dir() else _load_study_or_fail(file)
+    if not study.output.is_dir():
+        typer.echo(
+            f"study {study.name}: {count(len(study.runs), 'run')}, all pending: {missing_folder(study)}"
+        )
+        return
+    search = ""
+    if study.search is not None:   # replayed first: it adds the runs the search asks for next
+        from trackbench.study.read.limits import search_state
+        search = search_state(study)
+    counts, failed = status_counts(study)
+    kept = others_note(len(other_runs(study)))
+    typer.echo(
+        f"study {study.name}: {count(len(study.runs), 'run')}: {counts['completed']} done, "
+        f"{counts['failed']} failed, "
+        f"{counts['pending']} pending ({study.output}){'; ' + kept if kept else ''}"
+    )
+    if search:
+        typer.echo(search)
+    for run_id, why in failed:
+        typer.echo(f"  failed {run_id}: {why}")
+
+
+# --- replay commands ---------------------------------------------------------------
+
+@app.command(cls=_Command)
+def view(
+    path: Path = typer.Argument(
+        ...,
+        help="A run folder (recording.rrd inside), an .rrd or .nc file, or a study "
+        "(results folder or TOML) followed by RUN_ID.",
+    ),
+    run_id: Optional[str] = typer.Argument(None, help="Run id within a study (a unique prefix is enough)."),
+):
+    """Open the rerun viewer on a run's recording (needs a display; otherwise says how to
+    open it elsewhere)."""
+    from trackbench.cli.view import ViewError, open_viewer
+    if path.suffix == ".toml" and path.is_file():
+        path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
+    try:
+        code = open_viewer(path, run_id)
+    except (ViewError, ValueError) as e:
+        _fail(str(e), 3)
+    raise typer.Exit(code)
+
+
+@app.command(cls=_Command)
+def plot(
+    path: Path = typer.Argument(
+        ..., help="A run (.nc file or run folder) or a study (results folder or TOML)."
+    ),
+    out: Optional[Path] = typer.Option(
+        None,
+        "--out",
+        "-o",
+        help="Folder for the PNG files; default: "
+        "RUN_FOLDER/plots, NAME_plots beside a .nc file, STUDY/plots.",
+    ),
+    times: Optional[str] = typer.Option(
+        None,
+        help="Times (s) of the configuration figure, comma-separated; "
+        "default: the paper's 0.1,0.35,0.45 for a run of its length, else three "
+        "times spread over the run.",
+    ),
+):
+    """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
+    from trackbench.figures.plots import plot_run, plot_study, remove_stale
+    try:
+        tt = None if times is None else tuple(float(x) for x in times.split(",") if x.strip())
+    except ValueError:
+        _fail(f"--times {times!r}: expected numbers separated by commas, e.g. 0.1,0.35,0.45")
+    is_study = path.suffix == ".toml" or (
+        path.is_dir() and ((path / "summary.csv").exists() or (path / "runs").is_dir())
+    )
+    if path.suffix == ".toml":
+        path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
+    if out is None:
+        out = (path.parent / (path.stem + "_plots")) if path.is_file() and path.suffix == ".nc" else None
+    try:
+        if is_study:
+            if out is None:
+                out = path / "plots"
+            paths = plot_study(path, out)
+            for p in remove_stale(out, paths):
+                typer.echo(f"removed: {p} (not a figure of this study's axes now)")
+        else:
+            paths = plot_run(path, out if out is not None else path / "plots", times=tt)
+    except (FileNotFoundError, ValueError, ImportError) as e:
+        _fail(str(e))
+    for p in paths:
+        typer.echo(f"written: {p}")
+
+
+@app.command(cls=_Command)
+def record(
+    nc: Path = typer.Argument(..., help="A run's netCDF file (or a run folder holding timeseries.nc)."),
+    out: Optional[Path] = typer.Option(None, "--out", "-o", help="The .rrd file; default: beside the .nc "
+                                       "(recording.rrd in a run folder, NAME.rrd otherwise)."),
+    every: int = typer.Option(1, "--every", min=1, help="Log the side view at every k-th output frame."),
+):
+    """Write (or rewrite) the rerun recording of an existing run."""
+    import xarray as xr
+
+    from trackbench.figures.plots import find_timeseries
+    from trackbench.outputs.recording.record import RECORDING_NAME, write_recording
+    try:
+        src = find_timeseries(nc)
+    except FileNotFoundError as e:
+        _fail(str(e))
+    if out is None:
+        out = src.parent / (RECORDING_NAME if src.name == "timeseries.nc" else src.stem + ".rrd")
+    typer.echo(f"written: {write_recording(xr.load_dataset(src), out, every=every)}")
+
+
+
+def _usage_error():
+    """Click's UsageError, as the installed Typer has it (recent Typers carry their own Click)."""
+    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+
+
+def main():
+    """The command, in this process."""
+    import sys
+    _leave(command(sys.argv[1:]))
+
+
+def command(argv):
+    """Run the command ``argv``; its exit status. Click's own usage errors (an option of the
+    wrong type, an unknown option or command) in one line like the command's own, instead of
+    a framed panel."""
+    if argv[:1] == ["run"]:   # a process that runs one scenario holds numpy arrays only
+        from trackbench.warm.startup import without_dask_arrays
+        without_dask_arrays()
+    try:
+        code = app(args=list(argv), standalone_mode=False, prog_name="trackbench")
+    except _usage_error() as e:
+        if type(e).__name__ == "NoArgsIsHelpError":    # `trackbench study` alone: its help
+            e.show()
+            return 0
+        where = e.ctx.command_path if e.ctx is not None else "trackbench"
+        typer.secho(
+            f"error: {where}: {e.format_message()} (see '{where} --help')", fg=typer.colors.RED, err=True
+        )
+        code = 2
+    except typer.Abort:
+        typer.secho("error: interrupted", fg=typer.colors.RED, err=True)
+        code = 130
+    return code if isinstance(code, int) else 0
+
+
+def _leave(code):
+    """Exit without the interpreter's teardown of numpy, pandas, pyarrow and rich (0.1-0.2 s of
+    every study command, after its last word): by now the command has written and closed its
+    files, and its worker pool and threads are done. Not once rerun is loaded (`run`, `record`,
+    `view`): it flushes recordings at exit."""
+    import os
+    import sys
+    if "rerun" in sys.modules:
+        sys.exit(code)
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
+
+
+if __name__ == "__main__":
+    main()

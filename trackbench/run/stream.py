@@ -1,0 +1,167 @@
+"""A long run written to its netCDF file as it goes, so that its memory does not grow with
+its duration. The solver hands over its samples chunk by chunk (solvers/base.py run_chunks:
+the compiled loop pauses when its chunk is full and resumes with the same step, so the run
+takes the steps of a run in one piece); each chunk's variables are built as for a run in one
+piece (output.build_dataset, with the run's first sample in front: the energies are measured
+from it, and no other variable reads across samples) and appended along the file's unlimited
+time dimension. The peaks, first contacts and the run's attributes, located along the steps
+in the compiled loop as ever, are written when the run ends.
+
+The file grows under a temporary name beside its target and is renamed when the run ends
+(atomic.py): a run killed halfway leaves no file that looks complete. The file reads back
+(xarray) as the Dataset that simulate() returns, every array bit for bit (tests/test_long_runs.py).
+
+What streams: the reduced solver on rigid ground with the paper's track layout, stored in
+full (compact storage packs positions around their whole run's range; the soil's and the
+closed track's outputs read across the run). Other runs, and runs of at most one chunk,
+are built in memory as before.
+"""
+
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from trackbench.outputs.files.atomic import _umask, tmp_path
+from trackbench.solvers.base import CHUNK_ROWS, RunResult, n_samples
+
+
+def streamable(scenario, storage="full"):
+    """Whether `trackbench run` streams this run to its file (see the module's docstring)."""
+    return (
+        storage == "full"
+        and scenario["solver"] == "reduced"
+        and scenario["track"]["layout"] == "paper"
+        and scenario["terrain"].get("soil", "rigid") == "rigid"
+        and n_samples(scenario) > CHUNK_ROWS
+    )
+
+
+class _Appender:
+    """The time histories appended to a netCDF-4 file chunk by chunk, the rest at the end,
+    laid out as storage.write lays out a Dataset in full."""
+
+    def __init__(self, path):
+        import netCDF4
+        self.f = netCDF4.Dataset(path, "w", format="NETCDF4")
+        self.n = 0
+
+    def _create(self, ds, names):
+        from trackbench.outputs.files.storage import FULL_CODEC, layout
+        self.f.createDimension("time", None)
+        for dim, size in ds.sizes.items():
+            if dim != "time":
+                self.f.createDimension(dim, size)
+        for name in names:
+            var = ds.variables[name]
+            dtype, fill, extra, _, kw = layout(name, var, "full")
+            if var.ndim and name not in var.dims:
+                kw.update(FULL_CODEC)
+            chunks = [CHUNK_ROWS if d == "time" else ds.sizes[d] for d in var.dims]
+            v = self.f.createVariable(name, dtype, var.dims, fill_value=False if fill is None else fill,
+                                      chunksizes=chunks, **kw)
+            v.set_auto_maskandscale(False)
+            # HDF5's cache (64 MB a variable by default) kept every chunk written: two chunks
+            # suffice, the one being filled and the one before it (a chunk of samples from
+            # the solver may end short of a chunk of the file)
+            v.set_var_chunk_cache(size=2 * int(np.prod(chunks)) * np.dtype(dtype).itemsize, nelems=11,
+                                  preemption=1.0)
+            v.setncatts({**var.attrs, **extra})
+
+    def append(self, ds):
+        names = [k for k, v in ds.variables.items() if "time" in v.dims]
+        if self.n == 0:
+            self._create(ds, names)
+        n = ds.sizes["time"]
+        for name in names:
+            self.f.variables[name][self.n:self.n + n] = np.asarray(ds.variables[name].values)
+        self.n += n
+
+    def finish(self, ds):
+        """The variables without a time dimension, and the run's attributes; closes the file."""
+        from trackbench.outputs.files.storage import FULL_CODEC, layout
+        for name, var in ds.variables.items():
+            if "time" in var.dims:
+                continue
+            dtype, fill, extra, data, kw = layout(name, var, "full")
+            if var.ndim and name not in var.dims:
+                kw.update(FULL_CODEC)
+            v = self.f.createVariable(name, dtype, var.dims, fill_value=False if fill is None else fill, **kw)
+            v.set_auto_maskandscale(False)
+            v.setncatts({**var.attrs, **extra})
+            v[...] = data
+        self.f.setncatts({**ds.attrs, "storage": "full"})
+        self.close()
+
+    def close(self):
+        if self.f is not None and self.f.isopen():
+            self.f.close()
+
+
+class _Chunks:
+    """The solver's sink: each chunk's Dataset (the run's first sample in front, then dropped)
+    appended to the file."""
+
+    def __init__(self, scenario, parts, appender):
+        self.scenario, self.parts, self.appender = scenario, parts, appender
+        self.first = None
+        self.seat = []   # the seat's acceleration, every chunk's: its ride metrics read the whole run
+
+    def result(self, base, y, diag, stats, peaks=None):
+        dt = self.scenario["output_interval"]
+        n = y.shape[0]
+        if base == 0 and self.first is None:
+            self.first = (y[:1].copy(), diag[:1].copy())
+        skip = 0 if base == 0 else 1
+        t = np.arange(base, base + n) * dt
+        if skip:
+            y, diag, t = np.vstack([self.first[0], y]), np.vstack([self.first[1], diag]), np.r_[0.0, t]
+        pk = peaks if peaks is not None else np.zeros((0, 6))
+        return RunResult(t, y, diag, pk, stats), skip
+
+    def dataset(self, result, wall_time=0.0, solve_time=0.0):
+        from trackbench.outputs.dataset import build_dataset
+        model, eq, ground, resolved = self.parts
+        return build_dataset(self.scenario, model, eq, ground, resolved, result, wall_time, solve_time)
+
+    def __call__(self, base, y, diag, stats, peaks):
+        result, skip = self.result(base, y, diag, stats, peaks)
+        ds = self.dataset(result).isel(time=slice(skip, None))
+        self.seat.append(ds["seat_acceleration_y"].values)
+        self.appender.append(ds)
+
+    def ride(self):
+        """The ride metrics over the whole run (output.ride_variables)."""
+        from trackbench.outputs.dataset import ride_variables
+        a = np.concatenate(self.seat)
+        return ride_variables(self.scenario, a, np.arange(a.shape[0]) * self.scenario["output_interval"])
+
+
+def stream_run(scenario, path, failed_path):
+    """Run ``scenario`` streamed to ``path`` (completed) or ``failed_path`` (stopped early);
+    returns (the path written, completed?)."""
+    from trackbench.run.simulate import prepare
+    t_wall = time.perf_counter()
+    model, eq, ground, resolved, y0, run_solver = prepare(scenario)
+    tmp = tmp_path(path)
+    appender = _Appender(tmp)
+    try:
+        sink = _Chunks(scenario, (model, eq, ground, resolved), appender)
+        t_solve = time.perf_counter()
+        result = run_solver(scenario, model, y0, sink=sink)
+        solve_time = time.perf_counter() - t_solve
+        # the peaks and attributes: a run of the first sample with the run's peaks and statistics
+        first, _ = sink.result(0, sink.first[0], sink.first[1], result.stats, result.peaks)
+        ds = sink.dataset(first, time.perf_counter() - t_wall, solve_time)
+        ds = ds.assign(sink.ride())
+        appender.finish(ds)
+        target = Path(path if ds.attrs["status"] == "completed" else failed_path)
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, target)
+        return target, ds.attrs["status"] == "completed"
+    except BaseException:
+        appender.close()
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise

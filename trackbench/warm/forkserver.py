@@ -1,0 +1,201 @@
+"""The workers' fork server from the command's side: its start and stop, what the command
+tells it to warm (preload.py) and where the server says that it compiles: the one protocol
+both sides share, light enough for the command to import (no numba).
+
+The command starts the server before it reads the study file (the server's imports, about
+a second, then overlap the validation and the expansion of the runs), so the server cannot
+be told on its command line which kinds of model the runs need: it is told LATER, through
+warm_file(), which the command writes (announce) once it knows the runs, and which the
+server waits for after its imports."""
+
+import json
+import os
+from contextlib import contextmanager
+from pathlib import Path
+
+from trackbench.warm.startup import single_threaded_libraries
+
+WARM = "TRACKBENCH_WARM"    # the server's spec (JSON): {"scenarios": [...]} or {"file": path}; "flag"
+MAX_WARM = 4
+LATER = "later"             # start_workers(warm=LATER): the kinds come through warm_file()
+TINY = {"duration": 1e-3, "output_interval": 1e-3}   # the run that loads a kind's kernels
+
+
+def warm_kinds(scenarios):
+    """One scenario dict of each kind of compiled model among a study's runs (solver, track
+    layout and method each compile their own time loop; the soil, friction and contact
+    options are flags inside it), at most MAX_WARM."""
+    kinds = {}
+    for d in scenarios:
+        kinds.setdefault((d.get("solver"), d.get("track", {}).get("layout"), d.get("method")), d)
+    return list(kinds.values())[:MAX_WARM]
+
+
+def _tmp(kind):
+    import tempfile
+    return Path(tempfile.gettempdir()) / f"trackbench-{kind}-{os.getpid()}.json"
+
+
+def compile_flag():
+    """The file where this command's fork server says that it compiles (the progress shows it)."""
+    return _tmp("compiling")
+
+
+def warm_file():
+    """The file through which this command tells a server started with LATER what to warm."""
+    return _tmp("warm")
+
+
+def spec(warm):
+    """The server's WARM spec for start_workers(warm=...): a list of scenario dicts, or LATER."""
+    if warm == LATER:
+        warm_file().unlink(missing_ok=True)   # a file of an earlier process of the same pid
+        return {"file": str(warm_file()), "flag": str(compile_flag())}
+    return {"scenarios": warm, "flag": str(compile_flag())}
+
+
+def announce(scenarios):
+    """Tell the server what to warm (a list of scenario dicts; [] for nothing) when it waits for
+    it (started with LATER); a no-op otherwise, or once said."""
+    said = json.loads(os.environ.get(WARM) or "{}")
+    path = said.get("file")
+    if not path or os.path.exists(path):
+        return
+    tmp = f"{path}.{os.getpid()}.tmp"
+    with open(tmp, "w") as f:
+        json.dump({"scenarios": scenarios}, f)
+    os.replace(tmp, path)   # whole or not at all: the server reads it as soon as it appears
+
+
+def _told_later():
+    """Was the server of this process started with LATER (it waits for warm_file())?"""
+    return "file" in json.loads(os.environ.get(WARM) or "{}")
+
+
+def forget():
+    """Remove this command's files of the protocol (at its end). A server started again later
+    in this process (a long-lived one: a notebook, tests) then warms the paper's model instead
+    of waiting for a file no one will write."""
+    for p in (compile_flag(), warm_file()):
+        p.unlink(missing_ok=True)
+    if _told_later():
+        os.environ.pop(WARM, None)
+
+
+PRELOAD = "trackbench.warm.preload"
+
+
+def _context():
+    """The workers' multiprocessing context: a fork server preloaded with PRELOAD, or spawn
+    where the platform has no fork server."""
+    import multiprocessing
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    ctx = multiprocessing.get_context("forkserver")
+    ctx.set_forkserver_preload([PRELOAD])
+    return ctx
+
+
+def start_workers(executor="local", scheduler=None, warm=None):
+    """Start the fork server now (it loads in its own process while the command does its own
+    set-up); a no-op when it runs already, with spawn, or for a remote dask scheduler. warm:
+    scenario dicts whose models the server loads (or compiles, once for all workers, saying so
+    in compile_flag()) before it forks a worker, or LATER (the command says which through
+    announce, once it has read the study); default: the paper's. Once the server runs, a list
+    is announced to it (when it waits for one)."""
+    single_threaded_libraries()
+    if warm is not None and warm != LATER and _told_later():
+        announce(warm)
+    elif warm is not None:
+        os.environ[WARM] = json.dumps(spec(warm))
+    if scheduler:
+        return
+    ctx = _context()
+    if ctx.get_start_method() == "forkserver":
+        if executor == "dask":   # its nannies start worker processes from the same server
+            ctx.set_forkserver_preload(["distributed", PRELOAD])
+        from multiprocessing import forkserver
+        forkserver.ensure_running()
+
+
+def _warm_spawned():
+    """Pool initializer of spawned workers (no fork server): the fork server's preload, run
+    in the worker itself (importing preload.py warms the process), and rerun's set-up, which
+    the fork server leaves out. Warming is an optimisation only: a real run reports errors."""
+    try:
+        from trackbench.warm import preload
+        preload.warm_recording()
+    except Exception:  # noqa: BLE001
+        pass
+
+
+class ForkServerPools:
+    """The study's pool factory (study/execute/executors.PoolFactory) of the command line:
+    workers forked from a fork server that loaded the runs' kinds of model once."""
+
+    compile_flag = staticmethod(compile_flag)
+
+    def prepare(self, scenarios, executor="local", scheduler=None):
+        """The first wave's runs are known: the server loads their kinds while this process sets up."""
+        start_workers(executor, scheduler, warm=warm_kinds(scenarios))
+
+    def pool(self, workers):
+        from concurrent.futures import ProcessPoolExecutor
+        start_workers()
+        ctx = _context()
+        warm = _warm_spawned if ctx.get_start_method() == "spawn" else None
+        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=warm)
+
+    def dask_context(self):
+        """How a LocalCluster's nannies start their workers: from the same server."""
+        start_workers("dask")
+        return _context().get_start_method()
+
+    def close(self):
+        forget()
+
+
+def _server_pid():
+    """The pid of the fork server this process started, or None."""
+    from multiprocessing import forkserver
+    return getattr(forkserver._forkserver, "_forkserver_pid", None)
+
+
+def stop_server():
+    """Stop the fork server this process started (a command with nothing to run, or bad input
+    found after it started): it would otherwise finish its preload, a second of a core, for no
+    worker. Waited for, and multiprocessing told (its ForkServer._stop, which its own tests
+    use): a pool started later in this process then starts a new server instead of connecting
+    to the dying one."""
+    import signal
+    from multiprocessing import forkserver
+    pid = _server_pid()
+    if pid is not None:
+        try:
+            os.kill(pid, signal.SIGTERM)
+            forkserver._forkserver._stop()
+        except (ProcessLookupError, ChildProcessError):
+            pass
+    forget()
+
+
+@contextmanager
+def started_early(executor="local", scheduler=None):
+    """The server started before the command reads the study file (its imports, a second,
+    overlap the validation and the expansion of the runs); yields tell(scenarios), by which the
+    command says which runs there are to do once it knows. Stopped again when the block
+    raises (bad input) or there is nothing to run: it would otherwise load for no worker."""
+    start_workers(executor, scheduler, warm=LATER)
+    todo = []
+
+    def tell(scenarios):
+        todo[:] = list(scenarios)
+        announce(warm_kinds(todo))
+
+    try:
+        yield tell
+    except BaseException:
+        stop_server()
+        raise
+    if not todo:
+        stop_server()
