@@ -145,8 +145,8 @@ def test_a_stream_that_stops_leaves_no_file(long_flat, tmp_path, monkeypatch):
             raise KeyboardInterrupt
         return original(self, ds)
 
-    original = S._Appender.append
-    monkeypatch.setattr(S._Appender, "append", broken)
+    original = S.Appender.append
+    monkeypatch.setattr(S.Appender, "append", broken)
     with pytest.raises(KeyboardInterrupt):
         S.stream_run(long_flat, tmp_path / "run.nc", tmp_path / "run.failed.nc")
     assert list(tmp_path.iterdir()) == []

@@ -14,7 +14,7 @@ from trackbench.cli import view as V
 from trackbench.cli.app import app
 from trackbench.figures.plots import plot_run, plot_study, study_axes
 from trackbench.outputs import geometry as G
-from trackbench.outputs.dataset import write_netcdf
+from trackbench.outputs.files.netcdf import write_netcdf
 from trackbench.outputs.recording import entities as E
 from trackbench.outputs.recording import record as R
 from trackbench.outputs.recording import soil_view as S

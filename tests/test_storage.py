@@ -11,8 +11,8 @@ import pandas as pd
 import pytest
 import xarray as xr
 
-from trackbench.outputs.dataset import write_netcdf
 from trackbench.outputs.files import storage
+from trackbench.outputs.files.netcdf import write_netcdf
 from trackbench.study import StudyError, load_study, run_study, store
 
 REPO = Path(__file__).resolve().parents[1]

@@ -136,9 +136,121 @@ def test_plain_modules_never_import_numba():
         ("teeth", "teeth_jit"),
         ("indices", "indices_jit"),
         ("closed_track", "closed_track_jit"),
-        ("ride_metrics", "ride_metrics_jit"),
+        ("ride", "ride_jit"),
     ],
 )
 def test_plain_and_compiled_twins_are_named_alike(plain, compiled):
     names = {p.stem for p in _modules()}
     assert plain in names and compiled in names
+
+
+# --- the rooms and their arrows ------------------------------------------------------
+
+# each room's floor: a module imports from its own floor or below, never above (the package's
+# __init__ is the API, above all). scenario/ is data every room reads; warm/ only cli/ reads.
+FLOORS = {"_jitcache": 0, "status": 0, "version": 0, "model": 1, "scenario": 2, "solvers": 2, "run": 3,
+          "outputs": 3, "study": 4, "figures": 4, "cli": 5, "warm": 5}
+
+
+def _module_name(path):
+    parts = list(path.relative_to(ROOT.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts), parts[-1] == "__init__"
+
+
+def _imports():
+    """{module: {modules it imports, at its top or inside a function}} within trackbench."""
+    names = {_module_name(p)[0] for p in _modules()}
+    graph = {}
+    for path in _modules():
+        here, is_pkg = _module_name(path)
+        base = here.split(".") if is_pkg else here.split(".")[:-1]
+        out = graph.setdefault(here, set())
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Import):
+                out.update(a.name for a in node.names if a.name in names)
+            elif isinstance(node, ast.ImportFrom):
+                mod = node.module or ""
+                if node.level:
+                    mod = ".".join(base[: len(base) - node.level + 1] + ([mod] if mod else []))
+                if not mod.startswith("trackbench"):
+                    continue
+                subs = [f"{mod}.{a.name}" for a in node.names if f"{mod}.{a.name}" in names]
+                out.update(subs or [mod])
+    return graph
+
+
+def _cycles(graph):
+    """The strongly connected components of more than one module (Tarjan)."""
+    index, low, stack, on, found = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                found.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return found
+
+
+def test_no_import_cycle():
+    graph = {m: {w for w in ws if not m.startswith(w + ".")} for m, ws in _imports().items()}
+    assert not _cycles(graph), f"modules that import each other: {_cycles(graph)}"
+
+
+def _room(module):
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else None
+
+
+def test_rooms_import_downwards():
+    up = sorted(
+        f"{m} -> {w}"
+        for m, ws in _imports().items() if _room(m) is not None
+        for w in ws if _room(w) is not None and FLOORS[_room(w)] > FLOORS[_room(m)]
+    )
+    assert not up, "imports that run back up: " + "; ".join(up)
+
+
+def test_only_the_command_line_reaches_the_start_up_corner():
+    reach = sorted(f"{m} -> {w}" for m, ws in _imports().items() if _room(m) not in ("cli", "warm")
+                   for w in ws if _room(w) == "warm")
+    assert not reach, "modules below the command line that import trackbench.warm: " + "; ".join(reach)
+
+
+def test_the_package_works_without_its_start_up_corner(tmp_path):
+    """A copy of the package without warm/ imports every module outside cli/, and its command
+    line starts: the corner can go by touching the command line only."""
+    import shutil
+    copy = tmp_path / "trackbench"
+    shutil.copytree(ROOT, copy, ignore=shutil.ignore_patterns("__pycache__", "warm"))
+    code = (
+        "import importlib, pkgutil, trackbench\n"
+        "for m in pkgutil.walk_packages(trackbench.__path__, 'trackbench.'):\n"
+        "    if not m.name.startswith(('trackbench.cli', 'trackbench.warm')):\n"
+        "        importlib.import_module(m.name)\n"
+        "assert 'trackbench.warm' not in __import__('sys').modules\n"
+        "from trackbench.cli import app\n"
+        "print(trackbench.__file__)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path,
+                         env={**__import__("os").environ, "PYTHONPATH": str(tmp_path)})
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip() == str(copy / "__init__.py")

@@ -20,6 +20,7 @@ import pandas as pd
 import pytest
 import xarray as xr
 
+from trackbench.outputs.files import netcdf
 from trackbench.study import load_study, run_study, store
 from trackbench.study.execute import executors
 from trackbench.study.execute.runner import confirm
@@ -379,11 +380,14 @@ def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
         def shutdown(self, wait=True, cancel_futures=False):
             pass
 
-    monkeypatch.setattr(executors, "_new_pool", lambda workers: Pool())
+    class Pools(executors.PoolFactory):
+        def pool(self, workers):
+            return Pool()
+
     monkeypatch.setattr(executors, "wait", lambda futs, return_when: None)
     notes = []
     tasks = [{"run_id": f"r{i}", "meta": {}, "scenario": {}} for i in range(4)]
-    got = list(executors.run_local(tasks, workers=2, notify=notes.append))
+    got = list(executors.run_local(tasks, workers=2, notify=notes.append, pools=Pools()))
     assert sorted(t["run_id"] for t, _ in got) == ["r0", "r1", "r2", "r3"]  # each once
     rec = {t["run_id"]: r for t, r in got}
     assert rec["r1"]["status"] == "failed" and rec["r1"]["attempt"] == executors.MAX_ATTEMPTS == 3
@@ -406,7 +410,7 @@ def _serial(tasks, workers=2, notify=None, on_running=None):
 def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tmp_path, monkeypatch):
     p = write_study(tmp_path, "df")
     out = tmp_path / "df"
-    real = store.write_timeseries
+    real = netcdf.write_netcdf
     victim = load_study(p, output=out).runs[1].run_id
 
     def write(ds, path, storage="full"):
@@ -416,7 +420,7 @@ def test_injected_enospc_reason_says_disk_full_and_a_rerun_completes_the_rest(tm
         return real(ds, path, storage)
 
     monkeypatch.setattr(executors, "run_local", _serial)
-    monkeypatch.setattr(store, "write_timeseries", write)
+    monkeypatch.setattr(netcdf, "write_netcdf", write)
     o = run_study(p, output=out, quiet=True)
     assert list(o.summary.status) == ["completed", "failed", "completed"]
     assert o.problem().startswith("1 of 3 runs failed")
@@ -440,7 +444,7 @@ def test_hdf_error_is_called_a_full_disk_only_when_space_is_short(tmp_path, monk
     def hdf(ds, path, storage="full"):
         raise RuntimeError("NetCDF: HDF error")
 
-    monkeypatch.setattr(store, "write_timeseries", hdf)
+    monkeypatch.setattr(netcdf, "write_netcdf", hdf)
     rec = executors.execute_run(task)  # plenty of space: the error as it is
     assert rec["status_message"] == "RuntimeError: NetCDF: HDF error"
     Usage = namedtuple("Usage", "total used free")

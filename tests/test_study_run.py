@@ -418,7 +418,7 @@ def test_progress_says_when_the_workers_waited_for_the_compiler(tmp_path):
 
 
 def test_one_warm_scenario_per_kind_of_compiled_model():
-    from trackbench.warm.forkserver import warm_kinds
+    from trackbench.warm.protocol import warm_kinds
 
     paper = tb.Scenario.paper().to_dict()
     runs = [
@@ -439,10 +439,10 @@ def test_one_warm_scenario_per_kind_of_compiled_model():
 def test_workers_are_forks_of_a_single_threaded_preloaded_server():
     """The pool's workers come from the fork server: the kernels already loaded there, which had
     one thread when it forked (trackbench/study/preload.py says why that makes forking safe)."""
-    from trackbench.study.execute import executors
+    from trackbench.warm.forkserver import ForkServerPools
     from trackbench.warm.preload import facts
 
-    pool = executors._new_pool(2)
+    pool = ForkServerPools().pool(2)
     try:
         got = [f.result(timeout=300) for f in [pool.submit(facts) for _ in range(2)]]
     finally:
@@ -454,12 +454,12 @@ def test_workers_are_forks_of_a_single_threaded_preloaded_server():
 
 WARM_LATER = """
 import json, sys
-from trackbench.study.execute import executors
+from trackbench.warm.forkserver import ForkServerPools, start_workers
 from trackbench.warm.preload import facts
-from trackbench.warm.forkserver import LATER, announce, forget
-executors.start_workers(warm=LATER)
+from trackbench.warm.protocol import LATER, announce, forget
+start_workers(warm=LATER)
 announce(json.loads(sys.argv[1]))
-pool = executors._new_pool(1)
+pool = ForkServerPools().pool(1)
 print(json.dumps(pool.submit(facts).result(timeout=300)))
 pool.shutdown()
 forget()
@@ -480,12 +480,12 @@ def test_the_server_warms_what_the_command_announces_after_it_started(announced)
 
 STOPPED = """
 import json
-from trackbench.study.execute import executors
+from trackbench.warm.forkserver import ForkServerPools, start_workers, stop_server
 from trackbench.warm.preload import facts
-from trackbench.warm.forkserver import LATER, stop_server
-executors.start_workers(warm=LATER)
+from trackbench.warm.protocol import LATER
+start_workers(warm=LATER)
 stop_server()   # bad input found after the start: nothing will be announced
-pool = executors._new_pool(1)
+pool = ForkServerPools().pool(1)
 print(json.dumps(pool.submit(facts).result(timeout=60)))
 pool.shutdown()
 """

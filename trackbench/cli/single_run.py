@@ -6,6 +6,7 @@ from pathlib import Path
 
 from trackbench.model.ground.soil import SOIL_CHOICES
 from trackbench.outputs.quantities import accounted_balance
+from trackbench.outputs.variables import scenario_of
 from trackbench.scenario import RULES, UNITS, Scenario, ScenarioError, flatten, paper_step
 from trackbench.scenario.parameters_table import RANDOM_DEFAULTS, TERRAIN_KINDS, TERRAIN_RULES
 from trackbench.scenario.presets import PRESETS, preset_values
@@ -37,8 +38,7 @@ def _time(t, digits):
 
 def _unmet(ds, contact):
     """Why no obstacle was met where the first one was placed by time after the run's end."""
-    import json
-    terrain = json.loads(ds.attrs["scenario"])["terrain"]
+    terrain = scenario_of(ds)["terrain"]
     first = (terrain.get("obstacles") or [terrain])[0]
     planned = first.get("first_contact_time")
     if contact == contact or planned is None or planned <= ds.attrs["t_final"]:
@@ -220,7 +220,7 @@ def _run_to_file(sc, targets, storage):
             return xr.open_dataset(path, cache=False), path
         finally:
             netCDF4.set_chunk_cache(*cache)
-    from trackbench.outputs.dataset import write_netcdf
+    from trackbench.outputs.files.netcdf import write_netcdf
     from trackbench.run.simulate import simulate
     ds = simulate(sc)
     ok = ds.attrs["status"] == "completed"

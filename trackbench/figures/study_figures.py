@@ -16,21 +16,11 @@ from trackbench.figures.plot_common import (
     manifest,
     value_label,
 )
+from trackbench.outputs.variables import scenario_of
 
 BOOKKEEPING = {
-    "run_id",
-    "status",
-    "status_message",
-    "variant",
-    "replicate",
-    "steps",
-    "rejected_steps",
-    "t_final",
-    "wall_time",
-    "solve_time",
-    "recording",
-    "recording_error",
-    "seed",
+    "run_id", "status", "status_message", "variant", "replicate", "steps", "rejected_steps",
+    "t_final", "wall_time", "solve_time", "recording", "recording_error", "seed"
 }
 
 
@@ -372,7 +362,7 @@ def _steady_point(ds):
     from trackbench.outputs.metrics.traction import has_traction, run_soil, steady, wong
     if not has_traction(ds):
         return None
-    sc = json.loads(ds.attrs["scenario"])
+    sc = scenario_of(ds)
     soil = sc["terrain"].get("soil")
     fig = steady(ds, 0.5 * float(ds.time.values[-1]))
     bar = sc.get("drawbar", {})

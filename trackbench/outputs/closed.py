@@ -50,9 +50,7 @@ def _span_tensions(model, q, pins, tension, g):
 
 def closed_layout_vars(model, result, scenario, placed):
     """The closed layout's own variables: sprocket, idler, drive, span tensions."""
-    from trackbench.run.assemble import closed_parts
-
-    g = closed_parts(scenario)[0]
+    g = model.closed_parts[0]
     nw, nl, nq = model.nw, model.n_links, model.nq
     q, qd, d, y = result.y[:, :nq], result.y[:, nq : 2 * nq], result.diag, result.y
     i_s, i_i = L.q_sprocket(nw, nl), L.q_idler(nw, nl)
@@ -183,10 +181,8 @@ def soil_vars(model, result, ground, placed):
     }, x[lo:hi]
 
 
-def closed_attrs(scenario):
-    from trackbench.run.assemble import closed_parts
-
-    g, lp, guides = closed_parts(scenario)
+def closed_attrs(scenario, model):
+    g, lp, guides = model.closed_parts
     return {
         "track_layout": "closed",
         "closed_layout": json.dumps(

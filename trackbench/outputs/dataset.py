@@ -2,7 +2,6 @@
 and an atomic netCDF writer."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -11,7 +10,6 @@ from trackbench.model.core import indices as L
 from trackbench.model.dynamics.energy import paper_balance, work_residual
 from trackbench.model.vehicle.kinematics import place_samples
 from trackbench.outputs.closed import closed_attrs, closed_layout_vars, soil_vars
-from trackbench.outputs.files.atomic import atomic_path
 from trackbench.outputs.variables import WH, K, P, T
 from trackbench.outputs.variables import var as _var
 from trackbench.status import Result
@@ -302,24 +300,13 @@ def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solv
             "1",
             "track link number (joins pins b and b+1; link 0 joins the last pin and pin 1)",
         )
-        attrs.update(closed_attrs(scenario))
+        attrs.update(closed_attrs(scenario, model))
     gv = ("ground_vertex",)
     v["ground_x"] = _var(gv, ground.vertices[:, 0], "m", "x of the ground polyline's vertices")
     v["ground_y"] = _var(gv, ground.vertices[:, 1], "m", "height of the ground polyline's vertices")
     if rut_x is not None:
         coords["rut_x"] = _var(("rut_x",), rut_x, "m", "x of the soil's memory cells (centres)")
     return xr.Dataset(v, coords=coords, attrs=attrs)
-
-
-def write_netcdf(ds, path, storage="full"):
-    """Write atomically (trackbench/atomic.py): ``storage`` "full" (lossless, zstd) or
-    "compact" (time histories at a stated resolution), see trackbench/storage.py."""
-    from trackbench.outputs.files.storage import check_storage, write
-    check_storage(storage)
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        write(ds, tmp, storage)
-    return path
 
 
 def summary_numbers(ds):

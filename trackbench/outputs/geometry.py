@@ -21,10 +21,11 @@ Drawing choices (documented in results_schema.md, section "recording"):
   segment 2 x travel long, fixed in the chassis, the support rollers circles.
 """
 
-import json
 import math
 
 import numpy as np
+
+from trackbench.outputs.variables import attr_json, scenario_of  # noqa: F401  (G.attr_json, G.scenario_of)
 
 HULL_MARGIN = 0.1      # m beyond each track end
 HULL_BOTTOM = -0.3     # m below the mass centre (chassis frame)
@@ -43,15 +44,6 @@ TENSION_RGB = np.array([
     [240, 190, 0],     # twice it: amber
     [220, 30, 30],     # 300 kN and more: red
 ], dtype=float)
-
-
-def attr_json(ds, name):
-    v = ds.attrs[name]
-    return json.loads(v) if isinstance(v, (str, bytes)) else v
-
-
-def scenario_of(ds):
-    return attr_json(ds, "scenario")
 
 
 def tension_rgb(tension):

@@ -14,10 +14,11 @@ time something first happened; a "check" is an accuracy figure of the run. A qua
 when the run has it, and in a study's when any of its runs has it.
 """
 
-import json
 import math
 import re
 from dataclasses import dataclass
+
+from trackbench.outputs.variables import scenario_of
 
 
 @dataclass(frozen=True)
@@ -336,7 +337,7 @@ def tensioner_energy(ds):
     The paper's balance (energy_elastic) leaves it out."""
     if "idler_position" not in ds:
         return None
-    idler = json.loads(ds.attrs["scenario"])["idler"]
+    idler = scenario_of(ds)["idler"]
     s = ds["idler_position"].values
     return -idler["preload"] * s + 0.5 * idler["stiffness"] * s * s
 

@@ -172,6 +172,7 @@ class Model:
         self.n_links = int(tr["n_links"])
         arms = arm_table(piv, eq.phi0, arm_damping(v))
         parts = closed_parts(scenario)
+        self.closed_parts = parts   # (geometry, LP_* vector, guide table) of the closed layout, or None
         self.closed = parts is not None
         loop, guides = (parts[1], parts[2]) if self.closed else (None, None)
         rut = _soil(scenario, eq, par)

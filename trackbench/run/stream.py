@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from trackbench.outputs.files.atomic import _umask, tmp_path
+from trackbench.outputs.files.netcdf import Appender
 from trackbench.solvers.base import CHUNK_ROWS, RunResult, n_samples
 
 
@@ -36,67 +37,6 @@ def streamable(scenario, storage="full"):
         and scenario["terrain"].get("soil", "rigid") == "rigid"
         and n_samples(scenario) > CHUNK_ROWS
     )
-
-
-class _Appender:
-    """The time histories appended to a netCDF-4 file chunk by chunk, the rest at the end,
-    laid out as storage.write lays out a Dataset in full."""
-
-    def __init__(self, path):
-        import netCDF4
-        self.f = netCDF4.Dataset(path, "w", format="NETCDF4")
-        self.n = 0
-
-    def _create(self, ds, names):
-        from trackbench.outputs.files.storage import FULL_CODEC, layout
-        self.f.createDimension("time", None)
-        for dim, size in ds.sizes.items():
-            if dim != "time":
-                self.f.createDimension(dim, size)
-        for name in names:
-            var = ds.variables[name]
-            dtype, fill, extra, _, kw = layout(name, var, "full")
-            if var.ndim and name not in var.dims:
-                kw.update(FULL_CODEC)
-            chunks = [CHUNK_ROWS if d == "time" else ds.sizes[d] for d in var.dims]
-            v = self.f.createVariable(name, dtype, var.dims, fill_value=False if fill is None else fill,
-                                      chunksizes=chunks, **kw)
-            v.set_auto_maskandscale(False)
-            # HDF5's cache (64 MB a variable by default) kept every chunk written: two chunks
-            # suffice, the one being filled and the one before it (a chunk of samples from
-            # the solver may end short of a chunk of the file)
-            v.set_var_chunk_cache(size=2 * int(np.prod(chunks)) * np.dtype(dtype).itemsize, nelems=11,
-                                  preemption=1.0)
-            v.setncatts({**var.attrs, **extra})
-
-    def append(self, ds):
-        names = [k for k, v in ds.variables.items() if "time" in v.dims]
-        if self.n == 0:
-            self._create(ds, names)
-        n = ds.sizes["time"]
-        for name in names:
-            self.f.variables[name][self.n:self.n + n] = np.asarray(ds.variables[name].values)
-        self.n += n
-
-    def finish(self, ds):
-        """The variables without a time dimension, and the run's attributes; closes the file."""
-        from trackbench.outputs.files.storage import FULL_CODEC, layout
-        for name, var in ds.variables.items():
-            if "time" in var.dims:
-                continue
-            dtype, fill, extra, data, kw = layout(name, var, "full")
-            if var.ndim and name not in var.dims:
-                kw.update(FULL_CODEC)
-            v = self.f.createVariable(name, dtype, var.dims, fill_value=False if fill is None else fill, **kw)
-            v.set_auto_maskandscale(False)
-            v.setncatts({**var.attrs, **extra})
-            v[...] = data
-        self.f.setncatts({**ds.attrs, "storage": "full"})
-        self.close()
-
-    def close(self):
-        if self.f is not None and self.f.isopen():
-            self.f.close()
 
 
 class _Chunks:
@@ -145,7 +85,7 @@ def stream_run(scenario, path, failed_path):
     t_wall = time.perf_counter()
     model, eq, ground, resolved, y0, run_solver = prepare(scenario)
     tmp = tmp_path(path)
-    appender = _Appender(tmp)
+    appender = Appender(tmp, CHUNK_ROWS)
     try:
         sink = _Chunks(scenario, (model, eq, ground, resolved), appender)
         t_solve = time.perf_counter()

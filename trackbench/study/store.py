@@ -44,12 +44,6 @@ def _json_default(x):
     return str(x)
 
 
-def write_timeseries(ds, path, storage="full"):
-    """netCDF, atomically (output.write_netcdf), as ``storage`` says (trackbench/storage.py)."""
-    from trackbench.outputs.dataset import write_netcdf
-    return write_netcdf(ds, path, storage)
-
-
 def write_table(df, stem):
     """``stem``.csv always, ``stem``.parquet when pyarrow is importable; returns the paths."""
     stem = Path(stem)

@@ -49,7 +49,7 @@ def warm():
     import pandas  # noqa: F401  (the summary of a run's results)
     import xarray  # noqa: F401
 
-    from trackbench.outputs.dataset import write_netcdf
+    from trackbench.outputs.files.netcdf import write_netcdf
     from trackbench.outputs.quantities import run_summary
 
     _orphaned()
@@ -70,8 +70,8 @@ def _kinds():
     import json
 
     import trackbench
-    from trackbench.warm.forkserver import TINY as short
-    from trackbench.warm.forkserver import WARM
+    from trackbench.warm.protocol import TINY as short
+    from trackbench.warm.protocol import WARM
     spec = json.loads(os.environ.get(WARM) or "{}")
     kinds = _announced(spec["file"]) if spec.get("file") else spec.get("scenarios") or [None]
     for d in kinds:

@@ -103,27 +103,3 @@ def layout(name, var, storage):
         data.astype(np.float32),
         {"significant_digits": SIGNIFICANT_BITS, "quantize_mode": "BitRound"},
     )
-
-
-def write(ds, path, storage="full"):
-    """Write ``ds`` to the netCDF-4 file ``path`` (not atomically: output.write_netcdf is,
-    and it empties a temporary file that failed: netCDF keeps a file open whose closing
-    failed, e.g. on a full disk, and its space would stay taken)."""
-    import netCDF4
-    codec = COMPACT_CODEC if storage == "compact" else FULL_CODEC
-    f = netCDF4.Dataset(path, "w", format="NETCDF4")
-    try:
-        for dim, n in ds.sizes.items():
-            f.createDimension(dim, n)
-        for name, var in ds.variables.items():
-            dtype, fill, extra, data, kw = layout(name, var, storage)
-            if var.ndim and name not in var.dims:
-                kw.update(codec)
-            v = f.createVariable(name, dtype, var.dims, fill_value=False if fill is None else fill, **kw)
-            v.set_auto_maskandscale(False)   # the data are written as prepared here
-            v.setncatts({**var.attrs, **extra})
-            v[...] = data
-        f.setncatts({**ds.attrs, "storage": storage})
-    finally:
-        f.close()
-    return path

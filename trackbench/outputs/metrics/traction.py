@@ -31,6 +31,7 @@ from trackbench.model.ground.soil import (
     static_sinkage,
     wong_thrust,
 )
+from trackbench.outputs.variables import scenario_of
 
 TRACK_STILL = 1e-3      # m/s: slower than this, the sprocket lays no track and there is no slip
 
@@ -55,12 +56,12 @@ def mean_slip(chassis_speed, track_speed):
 
 def run_soil(ds):
     """The soil values of a run's scenario (None on rigid ground)."""
-    terrain = json.loads(ds.attrs["scenario"])["terrain"]
+    terrain = scenario_of(ds)["terrain"]
     return resolve_soil(terrain.get("soil", "rigid"))
 
 
 def _scenario(ds):
-    return json.loads(ds.attrs["scenario"])
+    return scenario_of(ds)
 
 
 def has_traction(ds):

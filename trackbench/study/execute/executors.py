@@ -21,6 +21,7 @@ from contextlib import contextmanager
 from datetime import datetime, timezone
 from pathlib import Path
 
+from trackbench.outputs.files import netcdf
 from trackbench.outputs.files.storage import frame_step, recording_steps
 from trackbench.outputs.quantities import run_summary
 from trackbench.study import store
@@ -213,7 +214,7 @@ def _write(ds, rdir, task, rec):
     (netCDF's writes and compression and rerun's encoding run outside the GIL); the solver's
     verdict in ``rec``. When timeseries.nc cannot be written the run fails and keeps no recording."""
     storage = task.get("storage", "full")
-    written = _in_thread(store.write_timeseries, ds, rdir / "timeseries.nc", storage)
+    written = _in_thread(netcdf.write_netcdf, ds, rdir / "timeseries.nc", storage)
     recording, err = _record(ds, rdir, task["scenario"], storage)
     exc = written()
     if exc is not None:
