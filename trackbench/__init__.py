@@ -20,7 +20,7 @@ __all__ = ["Scenario", "ScenarioError", "simulate", "open_study", "open_study_da
            "__version__"]
 
 
-def __getattr__(name):
+def __getattr__(name: str) -> object:
     if name not in _LAZY:
         raise AttributeError(f"module 'trackbench' has no attribute {name!r}")
     import importlib

@@ -1,13 +1,18 @@
 """The trackbench command line (Typer). Commands only: every piece of work lives in the package."""
 
+from __future__ import annotations
+
 from pathlib import Path
-from typing import List, Optional
+from typing import TYPE_CHECKING, Any, List, NoReturn, Optional
 
 import typer
 from typer.core import TyperCommand, TyperGroup
 
+if TYPE_CHECKING:
+    from trackbench.study.spec.study_file import Study
 
-def _untyped(option):
+
+def _untyped(option: Any) -> Any:
     """Typer labels its own --help flag `<bool>`; a flag takes no value, so no label."""
     if option is not None:
         option.metavar = ""
@@ -15,12 +20,12 @@ def _untyped(option):
 
 
 class _Command(TyperCommand):
-    def get_help_option(self, ctx):
+    def get_help_option(self, ctx: Any) -> Any:
         return _untyped(super().get_help_option(ctx))
 
 
 class _Group(TyperGroup):
-    def get_help_option(self, ctx):
+    def get_help_option(self, ctx: Any) -> Any:
         return _untyped(super().get_help_option(ctx))
 
 
@@ -31,12 +36,12 @@ study_app = typer.Typer(no_args_is_help=True, cls=_Group, help="Run and read par
 app.add_typer(study_app, name="study")
 
 
-def _fail(msg: str, code: int = 2):
+def _fail(msg: str, code: int = 2) -> NoReturn:
     typer.secho(f"error: {msg}", fg=typer.colors.RED, err=True)
     raise typer.Exit(code)
 
 
-def _version(value: bool):
+def _version(value: bool) -> None:
     if value:
         from trackbench.version import MODEL_VERSION, __version__
         typer.echo(f"trackbench {__version__} (model version {MODEL_VERSION})")
@@ -45,7 +50,7 @@ def _version(value: bool):
 
 @app.callback()
 def _main(version: bool = typer.Option(False, "--version", metavar="", callback=_version, is_eager=True,
-                                       help="Print the version and exit.")):
+                                       help="Print the version and exit.")) -> None:
     """Dynamics of high-mobility tracked vehicles (K. Lee, 2000)."""
 
 
@@ -76,7 +81,7 @@ def run(
         help="full (lossless) or compact (time histories at the resolution "
         "results_schema.md states, a thinner recording).",
     ),
-):
+) -> None:
     """Run one scenario (the paper's paper_step by default) and write OUT/NAME.nc."""
     from trackbench.cli.single_run import run_one
     from trackbench.scenario import ScenarioError
@@ -93,7 +98,7 @@ def run(
 
 
 @app.command(cls=_Command)
-def params():
+def params() -> None:
     """List every parameter name with its paper value and what is allowed."""
     from trackbench.cli.single_run import parameter_table
     typer.echo(parameter_table())
@@ -101,7 +106,7 @@ def params():
 
 # --- study commands ----------------------------------------------------------------
 
-def _load_study_or_fail(file: Path, output: Optional[Path] = None):
+def _load_study_or_fail(file: Path, output: Optional[Path] = None) -> Study:
     from trackbench.study import StudyError, load_study
     try:
         return load_study(file, output=output)
@@ -109,7 +114,7 @@ def _load_study_or_fail(file: Path, output: Optional[Path] = None):
         _fail(str(e))
 
 
-def _study_folder_or_fail(path: Path):
+def _study_folder_or_fail(path: Path) -> tuple[Study, Path]:
     """A study file or results folder -> (study, its results folder, which exists)."""
     from trackbench.study import StudyError
     from trackbench.study.read.folder import study_folder
@@ -149,7 +154,7 @@ def study_run(
         "study's \\[study] storage, "
         "else full. Runs already completed keep their files.",
     ),
-):
+) -> None:
     """Run every variant of a study (resumable: completed runs are skipped) and print the summary."""
     from trackbench.study.execute.executors import check_arguments
     from trackbench.warm.forkserver import ForkServerPools, started_early
@@ -187,7 +192,7 @@ def study_run(
 
 
 @study_app.command("summary", cls=_Command)
-def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
+def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")) -> None:
     """Print the study's summary table (rebuilt from the runs' run.json; summary files rewritten)."""
     from trackbench.study.read.summary import format_table, write_summary
     study, _ = _study_folder_or_fail(file)
@@ -196,7 +201,7 @@ def study_summary(file: Path = typer.Argument(..., help="Study file (TOML) or it
 
 
 @study_app.command("status", cls=_Command)
-def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")):
+def study_status(file: Path = typer.Argument(..., help="Study file (TOML) or its results folder.")) -> None:
     """Show how many runs are done, failed and pending (and how far a [search] is)."""
     from trackbench.study.execute.runner import count, other_runs, others_note, status_counts
     from trackbench.study.read.folder import missing_folder
@@ -233,7 +238,7 @@ def view(
         "(results folder or TOML) followed by RUN_ID.",
     ),
     run_id: Optional[str] = typer.Argument(None, help="Run id within a study (a unique prefix is enough)."),
-):
+) -> None:
     """Open the rerun viewer on a run's recording (needs a display; otherwise says how to
     open it elsewhere)."""
     from trackbench.cli.view import ViewError, open_viewer
@@ -264,7 +269,7 @@ def plot(
         "default: the paper's 0.1,0.35,0.45 for a run of its length, else three "
         "times spread over the run.",
     ),
-):
+) -> None:
     """Write PNG figures: a run's Figs. 8-18 of the paper, or a study's peak forces against each grid axis."""
     from trackbench.figures.plots import plot_run, plot_study, remove_stale
     try:
@@ -299,7 +304,7 @@ def record(
     out: Optional[Path] = typer.Option(None, "--out", "-o", help="The .rrd file; default: beside the .nc "
                                        "(recording.rrd in a run folder, NAME.rrd otherwise)."),
     every: int = typer.Option(1, "--every", min=1, help="Log the side view at every k-th output frame."),
-):
+) -> None:
     """Write (or rewrite) the rerun recording of an existing run."""
     import xarray as xr
 
@@ -315,18 +320,18 @@ def record(
 
 
 
-def _usage_error():
+def _usage_error() -> type[Exception]:
     """Click's UsageError, as the installed Typer has it (recent Typers carry their own Click)."""
-    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError")
+    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError" and issubclass(c, Exception))
 
 
-def main():
+def main() -> NoReturn:
     """The command, in this process."""
     import sys
     _leave(command(sys.argv[1:]))
 
 
-def command(argv):
+def command(argv: List[str]) -> int:
     """Run the command ``argv``; its exit status. Click's own usage errors (an option of the
     wrong type, an unknown option or command) in one line like the command's own, instead of
     a framed panel."""
@@ -335,7 +340,8 @@ def command(argv):
         without_dask_arrays()
     try:
         code = app(args=list(argv), standalone_mode=False, prog_name="trackbench")
-    except _usage_error() as e:
+    except _usage_error() as err:
+        e: Any = err
         if type(e).__name__ == "NoArgsIsHelpError":    # `trackbench study` alone: its help
             e.show()
             return 0
@@ -350,7 +356,7 @@ def command(argv):
     return code if isinstance(code, int) else 0
 
 
-def _leave(code):
+def _leave(code: int) -> NoReturn:
     """Exit without the interpreter's teardown of numpy, pandas, pyarrow and rich (0.1-0.2 s of
     every study command, after its last word): by now the command has written and closed its
     files, and its worker pool and threads are done. Not once rerun is loaded (`run`, `record`,

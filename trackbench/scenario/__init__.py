@@ -8,7 +8,9 @@ area are check_*.py.
 """
 
 import copy
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 
 class ScenarioError(ValueError):
@@ -60,22 +62,23 @@ class Scenario:
     """A validated, fully resolved scenario. Build with from_dict or paper().
     explicit: the dotted names set by the user rather than by defaults or a preset."""
 
-    data: dict
-    explicit: frozenset = frozenset()
+    data: dict[str, Any]
+    explicit: frozenset[str] = frozenset()
 
     @classmethod
-    def paper(cls, **overrides):
+    def paper(cls, **overrides: Any) -> "Scenario":
         return cls.from_dict(overrides)
 
     @classmethod
-    def from_dict(cls, overrides=None, base=None, explicit=None):
+    def from_dict(cls, overrides: Mapping[str, Any] | None = None, base: Mapping[str, Any] | None = None,
+                  explicit: frozenset[str] | None = None) -> "Scenario":
         """Defaults (the paper's run, or ``base``) updated by ``overrides``; keys may be
         nested tables or dotted names. A base given as a plain dict counts as explicit
         throughout (it is a resolved scenario: its preset values stay as they are)."""
-        d = copy.deepcopy(base if base is not None else paper_step())
+        d: dict[str, Any] = copy.deepcopy(dict(base) if base is not None else paper_step())
         if explicit is None:
             explicit = frozenset(flatten(d)) if base is not None else frozenset()
-        nested = {}
+        nested: dict[str, Any] = {}
         for k, v in (overrides or {}).items():
             if not isinstance(k, str):
                 raise ScenarioError(f"parameter names must be text, got {k!r}")
@@ -90,27 +93,27 @@ class Scenario:
         apply_preset(d, explicit)
         return cls(validate(d, explicit), explicit)
 
-    def with_overrides(self, overrides):
+    def with_overrides(self, overrides: Mapping[str, Any]) -> "Scenario":
         return Scenario.from_dict(overrides, base=self.data, explicit=self.explicit)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return copy.deepcopy(self.data)
 
-    def __getitem__(self, name):
+    def __getitem__(self, name: str) -> Any:
         d = self.data
         for p in name.split("."):
             d = d[p]
         return d
 
     @property
-    def name(self):
+    def name(self) -> str:
         return self.data["name"]
 
 
-def validate(d, explicit=frozenset()):
+def validate(d: Mapping[str, Any], explicit: frozenset[str] = frozenset()) -> dict[str, Any]:
     """The resolved scenario d checked area by area (values, terrain, sampling, geometry,
     extensions, closed track), as a new dict with values converted and derived ones filled in."""
-    out = copy.deepcopy(d)
+    out: dict[str, Any] = copy.deepcopy(dict(d))
     flat = flatten({k: v for k, v in d.items() if k != "terrain"})
     for name, value in flat.items():
         if name not in RULES:

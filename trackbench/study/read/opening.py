@@ -2,8 +2,13 @@
 run's Dataset), open_study_dataset (every run on a "run" dimension, lazily), open_limits (a
 search's limits.csv)."""
 
+from __future__ import annotations
+
 import importlib.util
+import os
+from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Union
 
 import numpy as np
 
@@ -13,12 +18,18 @@ from trackbench.study.read.limits import LIMITS_FILE
 from trackbench.study.read.summary import summary_frame
 from trackbench.study.spec.study_file import StudyError
 
-_STACK = dict(
+if TYPE_CHECKING:
+    import pandas as pd
+    import xarray as xr
+
+StudyPath = Union[str, "os.PathLike[str]"]   # a study file (TOML) or its results folder
+
+_STACK: dict[str, Any] = dict(
     join="outer", data_vars="all", coords="minimal", compat="override", combine_attrs="drop_conflicts"
 )
 
 
-def open_run(path, run):
+def open_run(path: StudyPath, run: int | str) -> xr.Dataset:
     """One run's Dataset (xarray.open_dataset) by run id, id prefix or row number."""
     import xarray as xr
     study = _study_of(path)
@@ -33,7 +44,7 @@ def open_run(path, run):
     return xr.open_dataset(store.run_dir(study.output, rid) / "timeseries.nc")
 
 
-def open_study(path, run=None):
+def open_study(path: StudyPath, run: int | str | None = None) -> pd.DataFrame | xr.Dataset:
     """The summary of a study (a study file or its results folder) as a pandas DataFrame,
     rebuilt from the runs' run.json; with ``run`` (id, id prefix or row number) that run's
     Dataset instead. ``df.attrs['study_dir']`` is the results folder."""
@@ -42,11 +53,11 @@ def open_study(path, run=None):
     return summary_frame(_study_of(path))
 
 
-def _have_dask():
+def _have_dask() -> bool:
     return importlib.util.find_spec("dask") is not None
 
 
-def _stacked(paths, lazy):
+def _stacked(paths: Sequence[Path], lazy: bool) -> xr.Dataset:
     """The runs' files along ``run``, lazily from their headers (stacked.py: one dask chunk per
     run where dask is installed); where they do not line up, with xarray.open_mfdataset where
     dask is installed (the `dask` extra), else read into memory (each file closed after reading)."""
@@ -61,7 +72,7 @@ def _stacked(paths, lazy):
     return xr.concat([xr.load_dataset(p) for p in paths], dim="run", **_STACK)
 
 
-def open_study_dataset(path, status=("completed", "failed")):
+def open_study_dataset(path: StudyPath, status: Iterable[str] = ("completed", "failed")) -> xr.Dataset:
     """All runs' time histories stacked along a ``run`` dimension, opened lazily: a run's file
     is read when a selection needs it (one dask chunk per run where dask is installed); runs of
     different durations are aligned on time (NaN-padded). The study's parameters and each run's status
@@ -81,7 +92,7 @@ def open_study_dataset(path, status=("completed", "failed")):
     return ds.assign_coords(coords)
 
 
-def open_limits(path):
+def open_limits(path: StudyPath) -> pd.DataFrame:
     """limits.csv of a study with [search] (a study file or its results folder) as a pandas
     DataFrame: one row per grid point, its parameters, search_value, status, runs."""
     import pandas as pd
