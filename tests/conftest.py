@@ -1,13 +1,9 @@
 """Shared runs: each is simulated once per test session and reused (numba JIT cached)."""
 
-import os
 
 import pytest
 
 import trackbench as tb
-
-# every command a test starts runs in its own process (tests/test_daemon.py starts its own)
-os.environ["TRACKBENCH_DAEMON"] = "off"
 
 
 @pytest.fixture(scope="session")

@@ -322,7 +322,8 @@ def record(
 
 def _usage_error() -> type[Exception]:
     """Click's UsageError, as the installed Typer has it (recent Typers carry their own Click)."""
-    return next(c for c in typer.BadParameter.__mro__ if c.__name__ == "UsageError" and issubclass(c, Exception))
+    return next(c for c in typer.BadParameter.__mro__
+                if c.__name__ == "UsageError" and issubclass(c, Exception))
 
 
 def main() -> NoReturn:
