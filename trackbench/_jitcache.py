@@ -2,8 +2,8 @@
 
 numba's own cache checks only the source file of each compiled function, not the files
 of the functions it calls and inlines: after an upgrade (or a `git pull` on an editable
-install) that changed only `model/kernels.py`, the cached time loop would still hold the
-old contact kernels. So the cache lives in a folder named by a hash of the source of the
+install) that changed only `model/contact/track_contacts.py`, the cached time loop would
+still hold the old contact kernels. So the cache lives in a folder named by a hash of the source of the
 compiled code (model/, solvers/, status.py): ~/.cache/trackbench/numba/<hash>; the last
 few folders are kept, and any folder used within a day (another install may be running
 from it). Setting NUMBA_CACHE_DIR yourself overrides this.

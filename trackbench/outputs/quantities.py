@@ -1,10 +1,11 @@
 """The summary quantities of a run, in one table.
 
 Every place that shows or stores a run's summary reads this table: the one-screen summary
-of `trackbench run` (runner.format_summary, output.summary_numbers), a study run's run.json
-``results`` and summary.csv columns (study/executors.py, study/summary.py), the replicate
-statistics, the study table on screen, the study plots and the solver text of a recording.
-The Dataset variables themselves are built by output.py (SI units, with long_names).
+of `trackbench run` (cli/single_run.format_summary, outputs/dataset.summary_numbers), a study
+run's run.json ``results`` and summary.csv columns (study/execute/executors.py,
+study/read/summary.py), the replicate statistics, the study table on screen, the study plots
+and the solver text of a recording. The Dataset variables themselves are built by
+outputs/dataset.py (SI units, with long_names).
 
 Kinds: a "peak" is an extremum of the motion, stored with its time (``<column>_time``) and
 given replicate statistics; a "mean" is a mean over the run's second half (t >= t_final / 2:

@@ -1,4 +1,4 @@
-"""Rough ground (/work/shared/spec/mobility.md, "Rough ground"): ISO 8608 random profiles
+"""Rough ground (docs/usage.md, "Terrain"): ISO 8608 random profiles
 (terrain.kind = "random") and measured profiles read from a CSV file (terrain.kind =
 "profile"), each as (x, height) arrays, x increasing.
 

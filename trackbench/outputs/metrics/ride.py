@@ -1,4 +1,4 @@
-"""Ride metrics of the driver's seat (/work/shared/spec/mobility.md, "Ride metrics"): what a
+"""Ride metrics of the driver's seat (docs/validation.md, "Mobility"): what a
 vertical seat acceleration a(t), sampled every dt, does to the person on the seat.
 
 - ``peak_seat_acceleration_g``: NRMM's legacy obstacle criterion, max |a| after a 30 Hz
