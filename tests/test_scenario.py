@@ -72,7 +72,7 @@ def test_cli_bad_input_is_one_line_and_nothing_written(tmp_path):
         [
             sys.executable,
             "-m",
-            "trackbench.cli.app",
+            "trackbench.cli",
             "run",
             "--set",
             "vehicle.chassis_mas=1",
@@ -92,7 +92,7 @@ def test_cli_run_writes_netcdf(tmp_path):
         [
             sys.executable,
             "-m",
-            "trackbench.cli.app",
+            "trackbench.cli",
             "run",
             "--set",
             "speed=12",
@@ -117,7 +117,7 @@ def test_cli_run_writes_netcdf(tmp_path):
 
 
 def test_cli_run_never_overwrites_and_marks_failures(tmp_path):
-    run = [sys.executable, "-m", "trackbench.cli.app", "run", "--duration", "0.01", "--out", str(tmp_path)]
+    run = [sys.executable, "-m", "trackbench.cli", "run", "--duration", "0.01", "--out", str(tmp_path)]
     assert subprocess.run(run, capture_output=True, text=True).returncode == 0
     first = (tmp_path / "paper_step.nc").stat().st_mtime_ns
     r = subprocess.run(run + ["--set", "speed=12"], capture_output=True, text=True)

@@ -400,7 +400,7 @@ def test_pool_gives_up_on_a_run_that_keeps_killing_its_worker(monkeypatch):
 # --- 4. disk full and other reasons a user can act on -----------------------------------------
 
 
-def _serial(tasks, workers=2, notify=None, on_running=None):
+def _serial(tasks, workers=2, notify=None, on_running=None, pools=None):
     """The local executor without its process pool, so that monkeypatches reach the worker code."""
     for t in tasks:
         t = executors._attempt(t, 1)

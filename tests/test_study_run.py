@@ -305,9 +305,9 @@ def test_open_study_dataset_aligns_different_durations(tmp_path, monkeypatch):
     assert np.isnan(cy[0, -5:]).all() and not np.isnan(cy[1]).any() and not np.isnan(cy[0, :31]).any()
     assert list(ds.duration.values) == [0.03, 0.05]
     # without dask (the README's plain install) the same dataset, read into memory
-    from trackbench.study.read import summary
+    from trackbench.study.read import opening
 
-    monkeypatch.setattr(summary, "_have_dask", lambda: False)
+    monkeypatch.setattr(opening, "_have_dask", lambda: False)
     eager = tb.open_study_dataset(tmp_path / "a")
     assert eager.chunks == {} and eager.identical(ds.load())
     ds.close()

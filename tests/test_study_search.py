@@ -248,7 +248,7 @@ def searched(tmp_path_factory):
     (d / "lim.toml").write_text(BASE.replace('name = "lim"', f'name = "lim"\noutput = "{out}"'))
     waves, real = [], executors.run_local
 
-    def stopping(tasks, workers=2, notify=None, on_running=None):
+    def stopping(tasks, workers=2, notify=None, on_running=None, pools=None):
         waves.append(len(tasks))
         for n, item in enumerate(real(tasks, workers, notify=notify, on_running=on_running)):
             if sum(waves[:-1]) + n == 7:
