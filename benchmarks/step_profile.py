@@ -26,7 +26,7 @@ from trackbench.model.dynamics.rhs import rhs
 from trackbench.solvers.common import pin_jacobian as PJ
 from trackbench.solvers.common.control import FAC_MIN, SAFETY
 from trackbench.solvers.imex.ark_tableau import ARK_TABLEAUS
-from trackbench.solvers.registry import run_function
+from trackbench.solvers.registry import SOLVERS, run_function
 from trackbench.solvers.rk.tableau import TABLEAUS
 
 S = importlib.import_module("trackbench.run.simulate")
@@ -43,7 +43,8 @@ class Window:
         eq = S.equilibrium(sc)
         self.ground, _ = S.build_ground(sc, eq)
         self.model = S.Model(sc, eq, self.ground)
-        self.y0 = run_function("reduced", "dopri5")(sc, self.model, S.initial_state(sc, eq)).y[-1].copy()
+        run = run_function("reduced", "dopri5")
+        self.y0 = run(self.model, S.initial_state(sc, eq), SOLVERS["reduced"].controls(sc)).y[-1].copy()
         self.ny = self.y0.size
         self.nq = self.model.nq
         self.diag = np.empty(L.n_diag(self.model.nw, self.model.n_links))

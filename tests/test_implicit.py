@@ -11,7 +11,7 @@ import trackbench as tb
 from trackbench.model.core import indices as L
 from trackbench.model.dynamics.rhs import rhs
 from trackbench.solvers.common.pin_jacobian import SQRT_EPS, jacobian_work, pin_jacobian, ring_colours
-from trackbench.solvers.registry import run_function
+from trackbench.solvers.registry import SOLVERS, run_function
 
 S = importlib.import_module("trackbench.run.simulate")
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6,
@@ -36,7 +36,8 @@ def _state(overrides, t):
     eq = S.equilibrium(sc)
     ground, _ = S.build_ground(sc, eq)
     model = S.Model(sc, eq, ground)
-    y = run_function("reduced", "dopri5")(sc, model, S.initial_state(sc, eq)).y[-1].copy()
+    run = run_function("reduced", "dopri5")
+    y = run(model, S.initial_state(sc, eq), SOLVERS["reduced"].controls(sc)).y[-1].copy()
     return model, y
 
 

@@ -6,7 +6,7 @@ import pytest
 
 import trackbench as tb
 from trackbench.outputs.files.storage import frame_step
-from trackbench.solvers.base import control
+from trackbench.run.simulate import controls
 
 FLAT = {"terrain": {"kind": "flat"}, "duration": 0.2}
 
@@ -47,15 +47,15 @@ def test_free_samples_agree_with_the_capped_run_to_the_tolerance(flat_runs):
 
 def test_the_paper_preset_keeps_its_cap_on_obstacles_only():
     paper = tb.Scenario.paper()
-    assert control(paper).h_max == paper["output_interval"] == 1e-4
+    assert controls(paper).h_max == paper["output_interval"] == 1e-4
     coarse = tb.Scenario.paper(output_interval=1e-3)
-    assert control(coarse).h_max == 1e-3   # as before: the paper's runs keep their bits
+    assert controls(coarse).h_max == 1e-3   # as before: the paper's runs keep their bits
     flat = tb.Scenario.from_dict({"terrain": {"kind": "flat"}})
-    assert flat["max_step"] == 0.0 and control(flat).h_max == flat["duration"]
+    assert flat["max_step"] == 0.0 and controls(flat).h_max == flat["duration"]
     damped = tb.Scenario.paper(preset="damped")
     assert damped["max_step"] == 0.0
     given = tb.Scenario.paper(preset="damped", max_step=2e-4)
-    assert control(given).h_max == 2e-4
+    assert controls(given).h_max == 2e-4
     # a scenario moved from flat ground onto a step takes the paper's sampling and cap again
     moved = flat.with_overrides({"terrain": {"kind": "step", "height": 0.1}})
     assert moved["output_interval"] == 1e-4 and moved["max_step"] == 1e-4
@@ -94,9 +94,8 @@ def test_a_run_in_chunks_is_the_run_in_one_piece(overrides):
     """The loop pauses when its chunk is full and resumes with the same step: the samples,
     peaks, first contacts and statistics are those of the run in one piece, bit for bit."""
     sc = tb.Scenario.from_dict(overrides)
-    model, _, _, _, y0, run = _prepared(sc)
-    whole = run(sc, model, y0)
-    model, _, _, _, y0, run = _prepared(sc)
+    whole = _prepared(sc)[-1]()
+    run = _prepared(sc)[-1]
     bases, ys, ds = [], [], []
 
     def sink(base, y, diag, stats, peaks):
@@ -104,7 +103,7 @@ def test_a_run_in_chunks_is_the_run_in_one_piece(overrides):
         ys.append(y.copy())
         ds.append(diag.copy())
 
-    part = run(sc, model, y0, sink=sink)
+    part = run(sink=sink)
     assert len(bases) == 2 and bases[0] == 0 and bases[1] == ys[0].shape[0]
     assert np.array_equal(whole.y, np.concatenate(ys), equal_nan=True)
     assert np.array_equal(whole.diag, np.concatenate(ds), equal_nan=True)
@@ -183,11 +182,10 @@ def test_a_long_recording_is_written_block_by_block(tmp_path):
 def test_the_step_cap_grows_with_the_simulated_time():
     """max_steps = 0 (the default) caps a run at 400,000 steps a simulated second, at least
     2,000,000 (a 20 s closed-track run takes about 3.2 million); a number caps it at that."""
-    from trackbench.solvers.base import control
-    cap = {d: control(tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": d})).max_steps
+    cap = {d: controls(tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": d})).max_steps
            for d in (0.5, 5.0, 20.0, 60.0)}
     assert cap == {0.5: 2_000_000, 5.0: 2_000_000, 20.0: 8_000_000, 60.0: 24_000_000}
     sc = tb.Scenario.from_dict({"terrain": {"kind": "flat"}, "duration": 20.0, "max_steps": 10_000})
-    assert control(sc).max_steps == 10_000
+    assert controls(sc).max_steps == 10_000
     with pytest.raises(tb.ScenarioError, match="max_steps = -1 is not allowed"):
         tb.Scenario.from_dict({"max_steps": -1})

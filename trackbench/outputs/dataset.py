@@ -12,6 +12,7 @@ from trackbench.model.vehicle.kinematics import place_samples
 from trackbench.outputs.closed import closed_attrs, closed_layout_vars, soil_vars
 from trackbench.outputs.variables import WH, K, P, T
 from trackbench.outputs.variables import var as _var
+from trackbench.solvers.registry import SOLVERS
 from trackbench.status import Result
 from trackbench.version import MODEL_VERSION, __version__, toolchain
 
@@ -236,7 +237,7 @@ def _attrs(scenario, model, eq, ground, resolved, st, wall_time, solve_time):
         "status_message": status.message,
         "t_final": float(st[L.S_T_FINAL]),
         "solver": scenario["solver"],
-        "method": scenario["method"] if scenario["solver"] == "reduced" else "lee-rkn",
+        "method": SOLVERS[scenario["solver"]].method_of(scenario["method"]),
         "tolerance": scenario["tolerance"],
         "steps": int(st[L.S_STEPS]),
         "rejected_steps": int(st[L.S_REJECTED]),

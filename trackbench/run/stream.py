@@ -25,17 +25,20 @@ import numpy as np
 
 from trackbench.outputs.files.atomic import _umask, tmp_path
 from trackbench.outputs.files.netcdf import Appender
-from trackbench.solvers.base import CHUNK_ROWS, RunResult, n_samples
+from trackbench.solvers.base import CHUNK_ROWS, RunResult
+from trackbench.solvers.registry import SOLVERS
 
 
 def streamable(scenario, storage="full"):
-    """Whether `trackbench run` streams this run to its file (see the module's docstring)."""
+    """Whether `trackbench run` streams this run to its file (see the module's docstring): its
+    solver's registry entry streams (takes a sink), and the run has more than one chunk."""
+    entry = SOLVERS[scenario["solver"]]
     return (
         storage == "full"
-        and scenario["solver"] == "reduced"
+        and entry.streams
         and scenario["track"]["layout"] == "paper"
         and scenario["terrain"].get("soil", "rigid") == "rigid"
-        and n_samples(scenario) > CHUNK_ROWS
+        and entry.controls(scenario).n_samples > CHUNK_ROWS
     )
 
 
@@ -83,13 +86,13 @@ def stream_run(scenario, path, failed_path):
     returns (the path written, completed?)."""
     from trackbench.run.simulate import prepare
     t_wall = time.perf_counter()
-    model, eq, ground, resolved, y0, run_solver = prepare(scenario)
+    model, eq, ground, resolved, y0, solve = prepare(scenario)
     tmp = tmp_path(path)
     appender = Appender(tmp, CHUNK_ROWS)
     try:
         sink = _Chunks(scenario, (model, eq, ground, resolved), appender)
         t_solve = time.perf_counter()
-        result = run_solver(scenario, model, y0, sink=sink)
+        result = solve(sink=sink)
         solve_time = time.perf_counter() - t_solve
         # the peaks and attributes: a run of the first sample with the run's peaks and statistics
         first, _ = sink.result(0, sink.first[0], sink.first[1], result.stats, result.peaks)

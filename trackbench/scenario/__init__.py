@@ -19,7 +19,7 @@ class ScenarioError(ValueError):
 
 # below ScenarioError: the check modules import it from this package
 from .check_closed import check_closed  # noqa: E402
-from .check_run import apply_preset, apply_sampling, check_extensions, check_sampling  # noqa: E402
+from .check_run import apply_preset, apply_sampling, check_extensions, check_sampling, check_solver  # noqa: E402
 from .check_terrain import check_placed_by_time, validate_terrain  # noqa: E402
 from .check_values import check_value, dotted_keys, flatten, merge, set_dotted, unknown  # noqa: E402
 from .check_vehicle import check_geometry  # noqa: E402
@@ -111,14 +111,15 @@ class Scenario:
 
 
 def validate(d: Mapping[str, Any], explicit: frozenset[str] = frozenset()) -> dict[str, Any]:
-    """The resolved scenario d checked area by area (values, terrain, sampling, geometry,
-    extensions, closed track), as a new dict with values converted and derived ones filled in."""
+    """The resolved scenario d checked area by area (values, solver, terrain, sampling,
+    geometry, extensions, closed track), as a new dict with values converted and derived ones filled in."""
     out: dict[str, Any] = copy.deepcopy(dict(d))
     flat = flatten({k: v for k, v in d.items() if k != "terrain"})
     for name, value in flat.items():
         if name not in RULES:
             raise unknown(name, parameter_names())
         set_dotted(out, name, check_value(name, value, RULES[name], name in OPEN_LOW))
+    check_solver(out)
     out["terrain"] = validate_terrain(d["terrain"])
     check_sampling(out)
     check_geometry(out["vehicle"], out["track"])

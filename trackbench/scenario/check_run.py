@@ -1,10 +1,12 @@
-"""Run-wide checks: presets filled in, the output sampling against the duration, and the
-models beyond the paper (coefficients that belong together, what the lee solver runs)."""
+"""Run-wide checks: presets filled in, the output sampling against the duration, the solver
+and method (solvers/registry.py), and the models beyond the paper (coefficients that belong
+together, what the solver runs)."""
 
 import copy
 import math
 
 from trackbench.scenario.presets import PRESETS, preset_values
+from trackbench.solvers.registry import SOLVERS, all_methods
 
 from . import ScenarioError
 from .check_values import flatten, set_dotted
@@ -48,13 +50,24 @@ def check_sampling(out):
         )
 
 
+def check_solver(d):
+    """solver names an entry of the registry as it is now (a solver registered at run time
+    validates too), and method one of its methods (of any solver's where it has no choice)."""
+    if d["solver"] not in SOLVERS:
+        raise ScenarioError(f"solver = {d['solver']!r} is not allowed: expected one of {', '.join(SOLVERS)}")
+    methods = SOLVERS[d["solver"]].methods or all_methods()
+    if d["method"] not in methods:
+        allowed = ", ".join(sorted(methods))
+        raise ScenarioError(f"method = {d['method']!r} is not allowed: expected one of {allowed}")
+
+
 def check_extensions(d, explicit):
     """The models beyond the paper: coefficients that belong together, sizes that must
-    match, and what the lee solver supports."""
+    match, and whether the solver runs them (its registry entry's extended_models)."""
     _check_contact_damping(d["contact"], explicit)
     _check_arm_damping(d["vehicle"])
-    if d["solver"] == "lee":
-        _check_lee(d)
+    if not SOLVERS[d["solver"]].extended_models:
+        _check_paper_model(d)
 
 
 def _check_contact_damping(c, explicit):
@@ -87,8 +100,8 @@ def _check_arm_damping(v):
             )
 
 
-def _check_lee(d):
-    """The lee solver runs the paper's model: the first extension set is named."""
+def _check_paper_model(d):
+    """A solver that runs the paper's model only: the first extension set is named."""
     c = d["contact"]
     ext = [
         name
@@ -104,7 +117,8 @@ def _check_lee(d):
         if on
     ]
     if ext:
+        able = " or ".join(f"solver = '{e.name}'" for e in SOLVERS.values() if e.extended_models)
         raise ScenarioError(
-            f"solver = 'lee' runs the paper's model only, but {ext[0]} is set; "
-            "use solver = 'reduced' for the models beyond the paper"
+            f"solver = '{d['solver']}' runs the paper's model only, but {ext[0]} is set; "
+            f"use {able} for the models beyond the paper"
         )

@@ -7,7 +7,7 @@ solver-specific figures go to RunResult.extra (results_schema.md, lee section)."
 from ...model.core import indices as L
 from ...model.core.bundles import event_arrays
 from ...model.dynamics.absolute import inverse_mass
-from ..base import allocate_outputs, control, trimmed
+from ..base import allocate_outputs, trimmed
 from .lee_loop import integrate_lee
 from .lee_work import (
     L_BUILDS,
@@ -173,16 +173,17 @@ _FIGURES = [
 ]
 
 
-def run(scenario, model, y0):
+def run(model, y0, controls):
+    """The run in one piece; Lee's settings are controls.settings (the registry's "lee" table)."""
+    own = controls.settings
     tab = RKN64.arrays()
-    out = allocate_outputs(scenario, model, y0.size)
+    out = allocate_outputs(controls, model, y0.size)
     lout = lee_outputs(out.y.shape[0], model.nw)
-    ls = LeeSettings(int(scenario["lee.accel_order"]), int(scenario["lee.eps_iterations"]),
-                     float(scenario["lee.position_tol"]), int(scenario["lee.max_iterations"]),
-                     float(scenario["lee.matrix_update_angle"]))
+    ls = LeeSettings(int(own["accel_order"]), int(own["eps_iterations"]), float(own["position_tol"]),
+                     int(own["max_iterations"]), float(own["matrix_update_angle"]))
     lw = lee_arrays(model.nw, model.n_links, tab.c.shape[0], L.n_diag(model.nw, model.n_links), y0.size)
     minv = inverse_mass(model.par, model.nw, model.n_links)
-    integrate_lee(y0, control(scenario), tab, ls, minv, model.arrays, model.work,
+    integrate_lee(y0, controls.loop_control, tab, ls, minv, model.arrays, model.work,
                   event_arrays(model.nw, model.n_links), lw, out, lout)
     n = int(out.stats[L.S_N_OUT])
     out_x, out_lam, lstats = lout
@@ -206,8 +207,8 @@ def run(scenario, model, y0):
         extra[name] = (dims, out_x[:n, k] if dims else lstats[k], units, text)
     extra["lee_accel_order"] = (
         (),
-        scenario["lee.accel_order"],
+        own["accel_order"],
         "1",
         "n of the accelerated iteration (A1-A6)",
     )
-    return trimmed(scenario, out, extra)
+    return trimmed(controls, out, extra)

@@ -8,7 +8,7 @@ import numpy as np
 from ...model.core import indices as L
 from ...model.core.indices import n_absolute
 
-# Lee's iteration settings (scenario lee.*)
+# Lee's iteration settings (controls.settings: the scenario's lee.* table, solvers/registry.py)
 LeeSettings = namedtuple("LeeSettings", ["accel_order", "eps_iterations", "position_tol", "max_iterations",
                                          "matrix_update_angle"])
 

@@ -5,6 +5,7 @@ import difflib
 import math
 
 from trackbench.scenario import parameter_names
+from trackbench.solvers.registry import settings_tables
 
 RANGE_KEYS = ("start", "stop", "step", "num")
 MAX_RUNS = 100_000
@@ -66,7 +67,7 @@ def expand_range(where, spec):
 def check_name(where, name):
     if name == "terrain" or name.startswith("terrain.") or name in parameter_names():
         return
-    if name in ("vehicle", "track", "lee", "record"):
+    if name in ("vehicle", "track", "record") or name in settings_tables():   # a table of them
         return
     close = difflib.get_close_matches(name, parameter_names(), n=3, cutoff=0.5)
     hint = f"; did you mean {', '.join(close)}?" if close else "; see `trackbench params` for the list"

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from trackbench.scenario import Scenario, ScenarioError, parameter_names
+from trackbench.solvers.registry import settings_tables
 from trackbench.study.spec.rules import (
     MAX_RUNS,
     RANGE_KEYS,
@@ -160,11 +161,11 @@ def _variants(doc, path):
 
 
 def flatten_axes(table):
-    """{'vehicle': {'chassis_mass': [..]}} -> {'vehicle.chassis_mass': [..]}; terrain stays whole
-    unless given by dotted name."""
+    """{'vehicle': {'chassis_mass': [..]}} -> {'vehicle.chassis_mass': [..]} (also a solver's
+    own settings table: solvers/registry.py); terrain stays whole unless given by dotted name."""
     out = {}
     for k, v in table.items():
-        if isinstance(v, dict) and k in ("vehicle", "track", "lee", "record"):
+        if isinstance(v, dict) and (k in ("vehicle", "track", "record") or k in settings_tables()):
             for k2, v2 in v.items():
                 out[f"{k}.{k2}"] = v2
         else:
