@@ -10,7 +10,7 @@ T, WH, P, K = ("time",), ("time", "wheel"), ("time", "pin"), ("time", "link")
 
 
 def var(dims, data, units, long_name, **attrs):
-    import xarray as xr   # here: reading a run's attributes (scenario_of) needs no xarray
+    import xarray as xr  # here: reading a run's attributes (scenario_of) needs no xarray
     return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name, **attrs})
 
 

@@ -1,20 +1,22 @@
 """A long run written to its netCDF file as it goes, so that its memory does not grow with
-its duration. The solver hands over its samples chunk by chunk (solvers/base.py run_chunks:
-the compiled loop pauses when its chunk is full and resumes with the same step, so the run
-takes the steps of a run in one piece); each chunk's variables are built as for a run in one
-piece (output.build_dataset, with the run's first sample in front: the energies are measured
-from it, and no other variable reads across samples) and appended along the file's unlimited
-time dimension. The peaks, first contacts and the run's attributes, located along the steps
-in the compiled loop as ever, are written when the run ends.
+its duration: the run's one pipeline (run/simulate.py Prepared) with a sink. The solver hands
+over its samples chunk by chunk (solvers/base.py run_chunks: the compiled loop pauses when its
+chunk is full and resumes with the same step, so the run takes the steps of a run in one
+piece); each chunk's variables are built as for a run in one piece (Prepared.dataset, with
+the run's first sample in front: the energies are measured from it, and no other variable
+reads across samples) and appended along the file's unlimited time dimension. The peaks,
+first contacts and the run's attributes, located along the steps in the compiled loop as
+ever, are written when the run ends.
 
 The file grows under a temporary name beside its target and is renamed when the run ends
-(atomic.py): a run killed halfway leaves no file that looks complete. The file reads back
-(xarray) as the Dataset that simulate() returns, every array bit for bit (tests/test_long_runs.py).
+(outputs/files/atomic.py): a run killed halfway leaves no file that looks complete. The file
+reads back (xarray) as the Dataset that simulate() returns, every array bit for bit
+(tests/test_long_runs.py).
 
-What streams: the reduced solver on rigid ground with the paper's track layout, stored in
-full (compact storage packs positions around their whole run's range; the soil's and the
-closed track's outputs read across the run). Other runs, and runs of at most one chunk,
-are built in memory as before.
+What streams: a solver whose registry entry streams (the reduced solver), on rigid ground
+with the paper's track layout, stored in full (compact storage packs positions around their
+whole run's range; the soil's and the closed track's outputs read across the run). Other
+runs, and runs of at most one chunk, are built in memory.
 """
 
 import os
@@ -46,8 +48,8 @@ class _Chunks:
     """The solver's sink: each chunk's Dataset (the run's first sample in front, then dropped)
     appended to the file."""
 
-    def __init__(self, scenario, parts, appender):
-        self.scenario, self.parts, self.appender = scenario, parts, appender
+    def __init__(self, run, appender):
+        self.run, self.scenario, self.appender = run, run.scenario, appender
         self.first = None
         self.seat = []   # the seat's acceleration, every chunk's: its ride metrics read the whole run
 
@@ -63,14 +65,9 @@ class _Chunks:
         pk = peaks if peaks is not None else np.zeros((0, 6))
         return RunResult(t, y, diag, pk, stats), skip
 
-    def dataset(self, result, wall_time=0.0, solve_time=0.0):
-        from trackbench.outputs.dataset import build_dataset
-        model, eq, ground, resolved = self.parts
-        return build_dataset(self.scenario, model, eq, ground, resolved, result, wall_time, solve_time)
-
     def __call__(self, base, y, diag, stats, peaks):
         result, skip = self.result(base, y, diag, stats, peaks)
-        ds = self.dataset(result).isel(time=slice(skip, None))
+        ds = self.run.dataset(result).isel(time=slice(skip, None))
         self.seat.append(ds["seat_acceleration_y"].values)
         self.appender.append(ds)
 
@@ -86,17 +83,17 @@ def stream_run(scenario, path, failed_path):
     returns (the path written, completed?)."""
     from trackbench.run.simulate import prepare
     t_wall = time.perf_counter()
-    model, eq, ground, resolved, y0, solve = prepare(scenario)
+    run = prepare(scenario)
     tmp = tmp_path(path)
     appender = Appender(tmp, CHUNK_ROWS)
     try:
-        sink = _Chunks(scenario, (model, eq, ground, resolved), appender)
+        sink = _Chunks(run, appender)
         t_solve = time.perf_counter()
-        result = solve(sink=sink)
+        result = run.solve(sink=sink)
         solve_time = time.perf_counter() - t_solve
         # the peaks and attributes: a run of the first sample with the run's peaks and statistics
         first, _ = sink.result(0, sink.first[0], sink.first[1], result.stats, result.peaks)
-        ds = sink.dataset(first, time.perf_counter() - t_wall, solve_time)
+        ds = run.dataset(first, time.perf_counter() - t_wall, solve_time)
         ds = ds.assign(sink.ride())
         appender.finish(ds)
         target = Path(path if ds.attrs["status"] == "completed" else failed_path)
