@@ -134,7 +134,7 @@ def _column(page, k):
     return page.eval_on_selector_all(f"#runs tbody tr td:nth-child({k})", "cs => cs.map(c => c.textContent)")
 
 
-def test_report_of_a_sweep_opens_offline_with_every_figure_and_run(sweep, browser):
+def test_report_of_a_sweep_opens_offline_with_every_figure_and_run(browser, sweep):
     path, facts = write_report(sweep)
     assert path == sweep / "report.html" and facts["runs"] == 3 and facts["failed"] == 1
     page, widths, rows = _open_report(browser, path)
@@ -152,7 +152,7 @@ def test_report_of_a_sweep_opens_offline_with_every_figure_and_run(sweep, browse
     page.close()
 
 
-def test_report_table_sorts_by_a_click(sweep, browser):
+def test_report_table_sorts_by_a_click(browser, sweep):
     path, _ = write_report(sweep)
     page, _, _ = _open_report(browser, path)
     speed = page.eval_on_selector_all("#runs thead th", "hs => hs.map(h => h.textContent)").index("speed") + 1
@@ -167,7 +167,7 @@ def test_report_table_sorts_by_a_click(sweep, browser):
     page.close()
 
 
-def test_report_of_a_search_has_its_limits_and_their_figures(limit_study, browser, tmp_path):
+def test_report_of_a_search_has_its_limits_and_their_figures(browser, limit_study, tmp_path):
     out = tmp_path / "elsewhere" / "limit.html"
     code = subprocess.run(CLI + ["report", str(limit_study), "--out", str(out)], capture_output=True,
                           text=True)
@@ -268,7 +268,7 @@ def _wheel_pixels(png):
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc for the processes left")
-def test_view_web_draws_the_vehicle_and_stops_clean_on_ctrl_c(recording, browser, tmp_path):
+def test_view_web_draws_the_vehicle_and_stops_clean_on_ctrl_c(browser, recording, tmp_path):
     port = _free_port()
     proc, lines = _serving(recording, port)
     try:
@@ -315,3 +315,15 @@ def test_view_web_refuses_a_file_that_is_no_recording(tmp_path):
     r = subprocess.run(CLI + ["view", str(bad), "--web", "--port", str(_free_port())], capture_output=True,
                        text=True, timeout=60)
     assert r.returncode == 3 and r.stderr.count("\n") == 1 and "is not a rerun recording" in r.stderr
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the parent-death signal is Linux's")
+def test_view_web_killed_outright_takes_its_viewer_with_it(recording):
+    proc, _ = _serving(recording, _free_port())
+    kids = _children(proc.pid)
+    proc.kill()
+    proc.communicate(timeout=20)
+    deadline = time.monotonic() + 10
+    while any(_alive(k) for k in kids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert kids and not [k for k in kids if _alive(k)]

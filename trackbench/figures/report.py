@@ -85,7 +85,8 @@ def _grid_section(study, df):
             vals.sort(key=float)
         except ValueError:
             pass
-        rows.append([f'<td class="t">{_E(name)}</td>', f'<td class="t">{_E(", ".join(vals))}</td>',
+        searched = " (searched)" if study.search is not None and name == study.search.parameter else ""
+        rows.append([f'<td class="t">{_E(name + searched)}</td>', f'<td class="t">{_E(", ".join(vals))}</td>',
                      f"<td>{len(vals)}</td>"])
     text = _table(["parameter", "values", "count"], rows) if rows else "<p>one run: the base scenario</p>"
     s = study.search

@@ -55,7 +55,9 @@ SCRIPT = """
       }
       return d || a[1] - b[1];
     });
-    keyed.forEach(function (k) { body.appendChild(k[2]); });
+    var sorted = document.createDocumentFragment();   // one reflow, not one a row
+    keyed.forEach(function (k) { sorted.appendChild(k[2]); });
+    body.appendChild(sorted);
   }
   for (var i = 0; i < heads.length; i++)
     heads[i].addEventListener("click", sortBy.bind(null, i));
