@@ -156,7 +156,7 @@ def _runs_section(df, params, folder_arg):
     heads = "".join([f'<th class="t">{h}</th>' for h in ("run", "status")]
                     + [f"<th>{_E(p)}</th>" for p in params]
                     + [f'<th title="{_E(tip)}">{_E(h)}</th>' for h, tip, _ in cols]
-                    + ['<th>wall s</th><th class="t">replay (add --web for a browser)</th>'])
+                    + ['<th>wall s</th><th class="t">replay: the viewer, or a browser</th>'])
     values = [df[p].to_numpy(object) for p in params] + [v for _, _, v in cols]
     wall = df["wall_time"].astype(float).to_numpy()
     rows = []
