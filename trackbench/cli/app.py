@@ -334,7 +334,7 @@ def report(
     except OSError as e:
         _fail(f"cannot write the report: {e.strerror or e} ({e.filename or out})", 1)
     typer.echo(f"written: {written} ({facts['runs']} runs, {facts['failed']} failed, {facts['figures']} "
-               f"figures, {facts['bytes'] / 1e6:.2f} MB); open it in a browser (file://{written.resolve()})")
+               f"figures, {facts['bytes'] / 1e6:.2f} MB); open it in a browser: {written.resolve().as_uri()}")
 
 
 @app.command(cls=_Command)
