@@ -238,14 +238,32 @@ def view(
         "(results folder or TOML) followed by RUN_ID.",
     ),
     run_id: Optional[str] = typer.Argument(None, help="Run id within a study (a unique prefix is enough)."),
+    run: Optional[str] = typer.Option(None, "--run", metavar="ID", help="The same as RUN_ID."),
+    limit: Optional[str] = typer.Option(
+        None, "--limit", metavar="POINT", help="A study with \\[search]: the run at the limit of grid point "
+        "POINT of limits.csv, its number (1 = the first row) or its values (terrain.height=0.2)."
+    ),
+    web: bool = typer.Option(False, "--web", metavar="", help="Serve it to a browser (rerun's web viewer) "
+                             "instead of opening a window; prints the address and the ssh port-forward."),
+    port: int = typer.Option(9090, "--port", help="With --web: the port to listen on."),
+    bind: str = typer.Option(
+        "127.0.0.1", "--bind", metavar="ADDRESS", help="With --web: the address to listen on; 0.0.0.0 "
+        "opens it to the network (anyone who reaches it sees the run)."
+    ),
 ) -> None:
     """Open the rerun viewer on a run's recording (needs a display; otherwise says how to
-    open it elsewhere)."""
-    from trackbench.cli.view import ViewError, open_viewer
+    open it elsewhere), or with --web serve it to a browser until Ctrl-C."""
+    from trackbench.cli.view import ViewError, open_viewer, serve_web
+    if run_id and run and run_id != run:
+        _fail(f"two run ids: {run_id} and --run {run}; give one")
+    run_id = run_id or run
     if path.suffix == ".toml" and path.is_file():
         path = _study_folder_or_fail(path)[1]   # its results folder, as `study run` put it
     try:
-        code = open_viewer(path, run_id)
+        if web:
+            code = serve_web(path, run_id, limit, port=port, bind=bind, echo=typer.echo)
+        else:
+            code = open_viewer(path, run_id, limit=limit)
     except (ViewError, ValueError) as e:
         _fail(str(e), 3)
     raise typer.Exit(code)
@@ -296,6 +314,27 @@ def plot(
         _fail(str(e))
     for p in paths:
         typer.echo(f"written: {p}")
+
+
+@app.command(cls=_Command)
+def report(
+    path: Path = typer.Argument(..., help="A study: its file (TOML) or its results folder."),
+    out: Optional[Path] = typer.Option(
+        None, "--out", "-o", help="The HTML file (or a folder for report.html); default: RESULTS/report.html."
+    ),
+) -> None:
+    """Write one HTML page of a study (opens offline): grid, figures, failures, the runs'
+    table (sortable) and the command that replays each run."""
+    from trackbench.figures.report import write_report
+    from trackbench.study import StudyError
+    try:
+        written, facts = write_report(path, out)
+    except (StudyError, ValueError) as e:
+        _fail(str(e))
+    except OSError as e:
+        _fail(f"cannot write the report: {e.strerror or e} ({e.filename or out})", 1)
+    typer.echo(f"written: {written} ({facts['runs']} runs, {facts['failed']} failed, {facts['figures']} "
+               f"figures, {facts['bytes'] / 1e6:.2f} MB); open it in a browser: {written.resolve().as_uri()}")
 
 
 @app.command(cls=_Command)

@@ -325,7 +325,8 @@ def plot_study(study_dir, out_dir):
         fig.savefig(path, dpi=DPI)
         plt.close(fig)
         paths.append(path)
-    drawbar = _plot_drawbar_pull(src, df[completed], out, has_drawbar=_has_drawbar(df, axes))
+    held = _has_drawbar(df, axes)   # else only runs on soft soil may have one: no other file opened
+    drawbar = _plot_drawbar_pull(src, df[completed], out, has_drawbar=held) if held or _on_soil(df) else None
     from trackbench.figures.limit_figures import plot_limits
     return paths + ([drawbar] if drawbar else []) + plot_limits(src, df, out, plt)
 
@@ -339,6 +340,12 @@ def remove_stale(out_dir, written):
     for p in stale:
         p.unlink(missing_ok=True)
     return stale
+
+
+def _on_soil(df):
+    """Some run of the summary is on soft soil (its soil quantities are columns)."""
+    from trackbench.outputs.quantities import TABLE
+    return any(q.needs == "soil" and q.present(df.columns) for q in TABLE)
 
 
 def _has_drawbar(df, axes):
