@@ -1,6 +1,6 @@
 """Drop test of the contact laws: a 20 kg pin meets a pad (k = 1e8 N/m) at 1 m/s; the
 restitution obtained is its exit speed / 1 m/s. The law is the compiled one the kernels
-use (model/contact_force.py). Run as a script to print the table of docs/validation.md:
+use (model/contact/laws_jit.py normal_force). Run as a script to print the table of docs/validation.md:
 
     python tests/drop.py
 """
@@ -10,7 +10,7 @@ import math
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from trackbench.model.contact.laws import DAMPINGS, LAWS, damping_ratio_for_restitution, restitution_factor
+from trackbench.model.contact.laws import DAMPING_LAWS, ELASTIC_LAWS, damping_ratio_for_restitution
 from trackbench.model.contact.laws_jit import normal_force
 
 PIN_MASS = 20.0
@@ -20,9 +20,10 @@ V = 1.0
 
 def drop(damping, e=1.0, zeta=0.0, n=1.0, ramp=2e-4, k=K, m=PIN_MASS, v=V):
     """Measured restitution of one impact (v0 = the impact speed, as at a located onset)."""
-    law = LAWS["linear"] if n == 1.0 else LAWS["power"]
-    code = DAMPINGS[damping]
-    chi = restitution_factor(code, e)
+    law = ELASTIC_LAWS["linear" if n == 1.0 else "power"].code
+    row = DAMPING_LAWS[damping]
+    code = row.code
+    chi = row.coefficient(e) if row.coefficient else 0.0
     c = 2.0 * zeta * math.sqrt(k * m)
 
     def rhs(t, s):
@@ -86,7 +87,7 @@ def table():
         for n in (1.0, 1.5):
             for e in (0.2, 0.5, 0.75, 0.9):
                 got = drop(law, e=e, n=n)
-                ref = restitution_law_closed_form(restitution_factor(DAMPINGS[law], e))
+                ref = restitution_law_closed_form(DAMPING_LAWS[law].coefficient(e))
                 rows.append(f"| {law} | {n:g} | {e} | {got:.4f} | {ref:.4f} | {got / e:.3f} |")
     return "\n".join(rows)
 

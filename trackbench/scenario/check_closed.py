@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from ..model.contact.laws import DAMPING_LAWS
 from ..model.vehicle.parameters import closed_defaults, paper_track
 from . import ScenarioError
 from .check_values import flatten, set_dotted
@@ -27,10 +28,13 @@ def check_closed(out, explicit):
             f"solver = '{out['solver']}' runs the paper's track layout only; use {able} with "
             "track.layout = 'closed'"
         )
-    if out["contact"]["damping"] not in ("none", "viscous"):
+    # the sprocket teeth keep no approach speeds: they take the viscous law's dashpot where
+    # contact.damping = 'viscous', else none (model/dynamics/closed_track_jit.py _teeth)
+    damping = out["contact"]["damping"]
+    if DAMPING_LAWS[damping].needs_approach_speed:
         raise ScenarioError(
-            f"contact.damping = '{out['contact']['damping']}' does not apply to the closed track's "
-            "sprocket teeth; allowed with track.layout = 'closed': none, viscous"
+            f"contact.damping = '{damping}' does not apply to the closed track's sprocket teeth; allowed "
+            f"with track.layout = 'closed': {', '.join(DAMPING_LAWS.names(needs_approach_speed=False))}"
         )
     out["rollers"]["positions"] = _pairs("rollers.positions", out["rollers"]["positions"])
     out["drive"]["curve"] = _pairs("drive.curve", out["drive"]["curve"], True, LP_CURVE_POINTS)

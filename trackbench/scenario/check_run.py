@@ -5,6 +5,7 @@ together, what the solver runs)."""
 import copy
 import math
 
+from trackbench.model.contact.laws import DAMPING_LAWS
 from trackbench.scenario.presets import PRESETS, preset_values
 from trackbench.solvers.registry import SOLVERS, all_methods
 
@@ -71,15 +72,14 @@ def check_extensions(d, explicit):
 
 
 def _check_contact_damping(c, explicit):
-    if c["damping"] == "viscous" and c["damping_ratio"] <= 0.0:
+    """The value a damping law's coefficient comes from (its row's parameter) is set."""
+    parameter = DAMPING_LAWS[c["damping"]].parameter
+    if parameter == "contact.damping_ratio" and c["damping_ratio"] <= 0.0:
         raise ScenarioError(
-            "contact.damping = 'viscous' needs contact.damping_ratio > 0 (e.g. 0.1); "
+            f"contact.damping = '{c['damping']}' needs contact.damping_ratio > 0 (e.g. 0.1); "
             "or contact.damping = 'none'"
         )
-    if (
-        c["damping"] in ("hunt_crossley", "lankarani_nikravesh", "flores")
-        and "contact.restitution" not in explicit
-    ):
+    if parameter == "contact.restitution" and "contact.restitution" not in explicit:
         raise ScenarioError(
             f"contact.damping = '{c['damping']}' needs contact.restitution, a number in (0, 1] (e.g. 0.75)"
         )

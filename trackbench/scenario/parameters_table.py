@@ -5,7 +5,7 @@ import math
 
 from trackbench.scenario.presets import PRESETS
 
-from ..model.contact.laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
+from ..model.contact.laws import DAMPING_LAWS, ELASTIC_LAWS, FRICTION_LAWS, GEOMETRIES
 from ..model.core.indices import DRIVES
 from ..model.ground.rough import CLASSES
 from ..model.vehicle.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle
@@ -110,9 +110,10 @@ RULES = {
     "track.ground_stiffness": _POS,
     "track.link_damping": (float, 0.0, math.inf, "a number >= 0 (N s/m)"),
     "vehicle.arm_damping": (list, None, None, "a list of one number >= 0 (N m s/rad) per road wheel, or []"),
-    "contact.law": (str, tuple(LAWS), None, "one of " + ", ".join(LAWS)),
+    # the law tables themselves: a law added to a table is allowed at once (str(): "one of ...")
+    "contact.law": (str, ELASTIC_LAWS, None, ELASTIC_LAWS),
     "contact.exponent": (float, 0.0, 3.0, "a number in (0, 3]"),
-    "contact.damping": (str, tuple(DAMPINGS), None, "one of " + ", ".join(DAMPINGS)),
+    "contact.damping": (str, DAMPING_LAWS, None, DAMPING_LAWS),
     "contact.damping_ratio": (float, 0.0, 10.0, "a number in [0, 10]"),
     "contact.restitution": (float, 0.0, 1.0, "a number in (0, 1]"),
     "contact.damping_ramp": (float, 0.0, 0.1, "a number in (0, 0.1] m"),

@@ -40,8 +40,8 @@ from ..core.indices import (
 )
 from ..core.jit import BORROW, INLINE
 from .gaps import pin_cap_weight, point_on_link
-from .laws import DAMPING_HUNT_CROSSLEY, DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
-from .laws_jit import friction, normal_force
+from .laws import DAMPING_NONE, GEOMETRY_CONTINUOUS, LAW_LINEAR
+from .laws_jit import friction, needs_approach_speed, normal_force
 
 
 @njit(**BORROW)
@@ -79,13 +79,13 @@ def _link_rate(vx, vy, avel, lk, b, d0):
 @njit(**BORROW)
 def law_force(law, delta, rate, mem, row, partner):
     """normal_force of one contact by a law beyond the paper's (compiled once, called:
-    the paper's linear spring stays inline in the loops). For the laws by restitution
-    the approach speed v0 is the one remembered at the pair's onset (remember_onsets),
+    the paper's linear spring stays inline in the loops). For the laws that need it the
+    approach speed v0 is the one remembered at the pair's onset (remember_onsets),
     or, for an onset inside the step being tried, the current rate, which becomes the
     memory once the step is accepted. mem = (v0 table, seen stamps, rates, counters,
     min approach speed)."""
     v0 = 1.0
-    if law[1] >= DAMPING_HUNT_CROSSLEY:
+    if needs_approach_speed(law[1]):
         v0tab, seen, rates, counters, v_min = mem
         seen[row, partner] = counters[C_EVALUATIONS]
         rates[row, partner] = rate

@@ -25,6 +25,12 @@ SCALAR = KERNEL
 # function must not create an array.
 BORROW = dict(KERNEL, _nrt=False)
 
+# The functions generated from a table when their caller is first compiled (the contact
+# laws' dispatch by code: model/contact/laws_jit.py). They are closures over the rows'
+# compiled functions, and numba keys a closure's cache entry by its cells, which differ in
+# every process: they are compiled into their callers, which are cached, never on their own.
+GENERATED = dict(KERNEL, cache=False)
+
 
 def _copy_inlined_ir_once():
     """Compile time: numba (0.68 and before, numba issue 8989) copies a function's IR for

@@ -165,18 +165,20 @@ def _check_reached(scenario, eq):
 
 
 def _check_memory_laws(scenario, ground):
-    """The restitution laws remember each pin's approach speed per ground segment, which a
-    candidate row holds for at most SEGMENT_CANDIDATES segments (model/core/indices.py)."""
-    from ..contact.laws import DAMPING_HUNT_CROSSLEY, DAMPINGS
+    """The laws that need the approach speed (the laws by restitution) remember a pin's per
+    ground segment, which a candidate row holds for at most SEGMENT_CANDIDATES segments
+    (model/core/indices.py)."""
+    from ..contact.laws import DAMPING_LAWS
     from ..core.indices import SEGMENT_CANDIDATES
 
     damping = scenario["contact.damping"]
     n = ground.segments.shape[0]
-    if DAMPINGS[damping] >= DAMPING_HUNT_CROSSLEY and n > SEGMENT_CANDIDATES:
+    if DAMPING_LAWS[damping].needs_approach_speed and n > SEGMENT_CANDIDATES:
+        allowed = ", ".join(repr(name) for name in DAMPING_LAWS.names(needs_approach_speed=False))
         raise ValueError(
-            f"contact.damping = {damping!r} cannot run on this ground of {n} segments: the restitution "
-            f"laws remember a contact per ground segment, up to {SEGMENT_CANDIDATES}; allowed on rough "
-            "ground: contact.damping = 'viscous' (the damped preset's) or 'none'"
+            f"contact.damping = {damping!r} cannot run on this ground of {n} segments: it remembers "
+            f"a contact's approach speed per ground segment, up to {SEGMENT_CANDIDATES}; allowed on "
+            f"rough ground: contact.damping = {allowed} (the damped preset's is 'viscous')"
         )
 
 

@@ -9,15 +9,7 @@ import math
 
 import numpy as np
 
-from ..contact.laws import (
-    BRISTLE_DAMPING_RATIO,
-    DAMPING_VISCOUS,
-    DAMPINGS,
-    FRICTION_LAWS,
-    GEOMETRIES,
-    LAWS,
-    restitution_factor,
-)
+from ..contact.laws import BRISTLE_DAMPING_RATIO, DAMPING_LAWS, ELASTIC_LAWS, FRICTION_LAWS, GEOMETRIES
 from ..core import indices as L
 
 
@@ -118,9 +110,9 @@ def closed_defaults():
 def paper_contact():
     """Contact laws: the paper's frictionless, undamped linear springs (section 2.2)."""
     return {
-        "law": "linear",                  # or "power": F = k delta^exponent
+        "law": "linear",                  # a name in model/contact/laws.py ELASTIC_LAWS
         "exponent": 1.5,                  # n of the power law (Hertz: 1.5)
-        "damping": "none",                # none, viscous, hunt_crossley, lankarani_nikravesh, flores
+        "damping": "none",                # a name in model/contact/laws.py DAMPING_LAWS
         "damping_ratio": 0.0,             # zeta of the viscous law
         "restitution": 1.0,               # e of the restitution-based laws
         "damping_ramp": 2e-4,             # d_r: depth over which the viscous dashpot ramps in (m)
@@ -159,16 +151,17 @@ def wheel_centres_body(vehicle):
 
 
 def _pack_contact(par, contact):
-    """The contact law's codes and coefficients (model/contact/laws.py) into par."""
-    par[L.P_CONTACT_LAW] = LAWS[contact["law"]]
-    par[L.P_CONTACT_EXPONENT] = contact["exponent"] if contact["law"] == "power" else 1.0
-    damping = DAMPINGS[contact["damping"]]
-    par[L.P_CONTACT_DAMPING] = damping
-    zeta = contact["damping_ratio"] if damping == DAMPING_VISCOUS else 0.0
+    """The contact laws' codes and coefficients (their rows in model/contact/laws.py) into par."""
+    elastic = ELASTIC_LAWS[contact["law"]]
+    par[L.P_CONTACT_LAW] = elastic.code
+    par[L.P_CONTACT_EXPONENT] = contact["exponent"] if elastic.parameter == "contact.exponent" else 1.0
+    damping = DAMPING_LAWS[contact["damping"]]
+    par[L.P_CONTACT_DAMPING] = damping.code
+    zeta = contact["damping_ratio"] if damping.parameter == "contact.damping_ratio" else 0.0
     # c = 2 zeta sqrt(k m_pin): the same rule for wheel, ground and corner contacts
     par[L.P_C_WHEEL] = 2.0 * zeta * math.sqrt(par[L.P_K_WHEEL] * par[L.P_PIN_MASS])
     par[L.P_C_GROUND] = 2.0 * zeta * math.sqrt(par[L.P_K_GROUND] * par[L.P_PIN_MASS])
-    par[L.P_RESTITUTION_FACTOR] = restitution_factor(damping, contact["restitution"])
+    par[L.P_RESTITUTION_FACTOR] = damping.coefficient(contact["restitution"]) if damping.coefficient else 0.0
     par[L.P_DAMPING_RAMP] = contact["damping_ramp"]
     par[L.P_MIN_APPROACH] = contact["min_approach_speed"]
     par[L.P_CONTACT_GEOMETRY] = GEOMETRIES[contact["geometry"]]

@@ -27,7 +27,8 @@ from ...model.contact.gaps import (
     point_on_link,
     segment_coords,
 )
-from ...model.contact.laws import DAMPING_VISCOUS, GEOMETRY_CONTINUOUS
+from ...model.contact.laws import GEOMETRY_CONTINUOUS
+from ...model.contact.laws_jit import ramps_in
 from ...model.core import fixed_math as fm
 from ...model.core.bundles import ClosedEventWork
 from ...model.core.indices import (
@@ -373,7 +374,7 @@ def first_contact_switch(y0, f0, y1, f1, h, m, ev):
     nq = m.pins[PN_NQ]
     _place_ends(y0, y1, nq, m, ev)
     step = (y0, f0, y1, f1, h)
-    ramp = m.par[P_DAMPING_RAMP] if m.par[P_CONTACT_DAMPING] == DAMPING_VISCOUS else -1.0
+    ramp = m.par[P_DAMPING_RAMP] if ramps_in(int(m.par[P_CONTACT_DAMPING])) else -1.0
     soil = m.par[P_SOIL] != 0.0
     best = 2.0
     for kind in range(N_KINDS):
