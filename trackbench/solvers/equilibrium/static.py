@@ -79,7 +79,7 @@ def _balance(P, u, it, first_pin=0):
 
 def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=1e-12, max_iter=60):
     """Newton's method from the wheels resting on the track and the track on the ground
-    (soil: {P_* index: value} of soft soil, assembly.soil_par). A power law is reached by
+    (soil: {P_* index: value} of soft soil, run/assemble.soil_par). A power law is reached by
     continuation (continuation.py)."""
     P = StaticProblem(vehicle, track, gravity, contact, soil)
     rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
