@@ -128,8 +128,8 @@ def terrain_label(t):
         text = f"points ({len(t.get('points', []))})"
     else:
         text = kind
-        if "height" in t:
-            text += f" {float(t['height']):g} m"
+        if "height" in t or "radius" in t:
+            text += f" {float(t.get('height', t.get('radius'))):g} m"
         if "length" in t:
             text += f" x {float(t['length']):g} m"
     soil = t.get("soil")

@@ -56,6 +56,8 @@ def _rough(t, kind):
     allowed = TERRAIN_KEYS[kind]
     out = {"kind": kind, **(RANDOM_DEFAULTS if kind == "random" else {})}
     out.update(_checked_keys(t, "terrain", f"kind '{kind}'", allowed))
+    if "rms_in" in out and "wavelength_max" not in t:   # NRMM's RMS: its band ends at 60 ft
+        out["wavelength_max"] = rough.NRMM_WAVELENGTH_MAX
     try:
         if kind == "profile":
             if "file" not in out:
@@ -67,7 +69,7 @@ def _rough(t, kind):
                 f"{4 * rough.SPACING:g} m (the profile is sampled every {rough.SPACING:g} m)"
             )
         else:
-            rough.check_random(out["length"], out["seed"], out.get("roughness_class"), out.get("rms"),
+            rough.check_random(out["length"], out["seed"], out.get("roughness_class"), rough.rms_of(out),
                                out["wavelength_min"], out["wavelength_max"], rough.SPACING, out["run_in"],
                                rough.BLEND)
     except ValueError as e:
@@ -142,7 +144,8 @@ def _validate_obstacle(ob, where, first):
     kind = check_value(where + ".kind", ob.get("kind"), OBSTACLE_KIND_RULE)
     allowed = OBSTACLE_KEYS[kind] if where != "terrain" else TERRAIN_KEYS[kind]
     out = {"kind": kind, **_checked_keys(ob, where, f"a {kind}", allowed)}
-    for need in ("height",) + (("length",) if kind != "step" else ()):
+    needs = ("radius",) if kind == "halfround" else ("height",) + (("length",) if kind != "step" else ())
+    for need in needs:
         if need not in out:
             raise ScenarioError(f"{where}.{need} is missing: a {kind} needs {need}")
     _check_placement(out, where, first, allowed)

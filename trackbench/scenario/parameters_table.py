@@ -18,8 +18,9 @@ ROUGHNESS_CLASSES = tuple(CLASSES)
 SOLVERS = tuple(_REGISTRY)
 # each solver's own settings table (SolverEntry.settings, e.g. lee.*): its Settings by table
 _SOLVER_TABLES = {e.settings: e.setting_rules for e in _REGISTRY.values() if e.settings}
-TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "points", "sequence", "random", "profile")
-OBSTACLE_KINDS = ("step", "ramp", "block", "bump")
+TERRAIN_KINDS = ("flat", "step", "ramp", "block", "bump", "halfround", "points", "sequence", "random",
+                 "profile")
+OBSTACLE_KINDS = ("step", "ramp", "block", "bump", "halfround")
 PLACEMENT_KEYS = ("position", "first_contact_time", "gap")  # where an obstacle stands: one of them
 PAPER_FIRST_CONTACT_TIME = 0.0568  # s: also the default of a first obstacle given no placement
 # The grounds a run rides over rather than meets obstacles on: what is read of them is the
@@ -240,6 +241,8 @@ UNITS = {
     "terrain.first_contact_time": "s",
     "terrain.gap": "m",
     "terrain.rms": "m",
+    "terrain.rms_in": "in",
+    "terrain.radius": "m",
     "terrain.wavelength_min": "m",
     "terrain.wavelength_max": "m",
     "terrain.run_in": "m",
@@ -267,6 +270,7 @@ TERRAIN_RULES = {
     "kind": (str, TERRAIN_KINDS, None, "one of " + ", ".join(TERRAIN_KINDS)),
     "height": (float, 0.0, 10.0, "a number in (0, 10] m"),
     "length": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
+    "radius": (float, 0.0, 5.0, "a number in (0, 5] m (a half-round's radius, its height)"),
     "position": (float, -900.0, 900.0, "a number in [-900, 900] m (x of the obstacle's start)"),
     "first_contact_time": (float, 0.0, 1000.0, "a number in (0, 1000] s"),
     "gap": (float, 0.0, 1000.0, "a number in [0, 1000] m"),
@@ -275,13 +279,15 @@ TERRAIN_RULES = {
     "soil": (str, None, None, "rigid, a soil name (trackbench params) or a table of soil values"),
     "roughness_class": (str, ROUGHNESS_CLASSES, None, "one of " + ", ".join(ROUGHNESS_CLASSES)),
     "rms": (float, 0.0, 1.0, "a number in (0, 1] m (the profile's RMS elevation over its band)"),
+    "rms_in": (float, 0.0, 40.0, "a number in (0, 40] in (NRMM's RMS elevation: wavelengths up to 60 ft)"),
     "seed": (int, 0, 2**63 - 1, "an integer >= 0"),
     "wavelength_min": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
     "wavelength_max": (float, 0.0, 1000.0, "a number in (0, 1000] m"),
     "run_in": (float, 0.0, 1000.0, "a number in [0, 1000] m (flat ground before the rough section)"),
     "file": (str, None, None, "a CSV file of x, height (m)"),
 }
-TERRAIN_OPEN_LOW = ("height", "length", "first_contact_time", "rms", "wavelength_min", "wavelength_max")
+TERRAIN_OPEN_LOW = ("height", "length", "radius", "first_contact_time", "rms", "rms_in", "wavelength_min",
+                    "wavelength_max")
 OBSTACLE_KIND_RULE = (str, OBSTACLE_KINDS, None, "one of " + ", ".join(OBSTACLE_KINDS))
 # the keys each kind takes: as the whole terrain, and as one obstacle of a sequence
 TERRAIN_KEYS = {
@@ -290,9 +296,11 @@ TERRAIN_KEYS = {
     "ramp": {"height", "length", "position"},
     "block": {"height", "length", "position", "first_contact_time"},
     "bump": {"height", "length", "position"},
+    "halfround": {"radius", "position"},
     "points": {"points"},
     "sequence": {"obstacles"},
-    "random": {"roughness_class", "rms", "length", "seed", "wavelength_min", "wavelength_max", "run_in"},
+    "random": {"roughness_class", "rms", "rms_in", "length", "seed", "wavelength_min", "wavelength_max",
+               "run_in"},
     "profile": {"file"},
 }
 # a random profile's defaults (model/ground/rough.py): 100 m of rough ground after 10 m of flat
@@ -304,6 +312,7 @@ OBSTACLE_KEYS = {
     "ramp": {"height", "length", "position", "gap"},
     "block": {"height", "length", "position", "gap", "first_contact_time"},
     "bump": {"height", "length", "position", "gap"},
+    "halfround": {"radius", "position", "gap"},
 }
 
 

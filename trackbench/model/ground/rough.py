@@ -35,6 +35,11 @@ N0 = 0.1   # cycle/m, ISO 8608's reference wavenumber
 SPACING = 0.05   # m: a run's random profile sampled at most this far apart (a tenth of the
 #                  shortest default wavelength; the links are 0.19 m)
 BLEND = 5.0      # m: a run's random profile fades in over this much of its rough section
+# NRMM states a course's roughness as the RMS elevation in inches after removing wavelengths
+# longer than 60 ft (WES's detrending, as Project Chrono's RandomSurfaceTerrain.h notes it):
+# with terrain.rms_in the band ends there, and rms = rms_in x 0.0254 m over the band
+NRMM_WAVELENGTH_MAX = 60 * 0.3048   # m
+INCH = 0.0254                       # m
 CLASSES = {      # Gd(n0), m^3: the classes' geometric means
     "A": 16e-6, "B": 64e-6, "C": 256e-6, "D": 1024e-6,
     "E": 4096e-6, "F": 16384e-6, "G": 65536e-6, "H": 262144e-6,
@@ -50,6 +55,17 @@ def _number(name, value, low, what, strict=True):
     if not ok:
         raise ValueError(f"{name} = {value!r} is not allowed: expected {what}")
     return value
+
+
+def rms_of(terrain):
+    """The RMS elevation (m) a random terrain table asks for: rms, or NRMM's rms_in in inches
+    (over its band: NRMM_WAVELENGTH_MAX unless wavelength_max is given), else None."""
+    if terrain.get("rms_in") is not None:
+        if terrain.get("rms") is not None:
+            raise ValueError(f"rms = {terrain['rms']!r} and rms_in = {terrain['rms_in']!r} are both given: "
+                             "expected one of them")
+        return terrain["rms_in"] * INCH
+    return terrain.get("rms")
 
 
 def _seed(seed):

@@ -52,8 +52,23 @@ def ground_from_points(points, merge_straight=False):
     return Ground(verts, np.ascontiguousarray(seg), np.ascontiguousarray(corners.reshape(-1, 2)))
 
 
+HALFROUND_CHORDS = 36   # a half-round as a polygon of chords of 5 deg, its vertices on the circle
+
+
+def halfround_points(x, radius):
+    """A half-round of ``radius`` (a half-cylinder lying across the path, NG-NRMM's obstacle)
+    whose front foot is at x: HALFROUND_CHORDS chords, the feet exactly on the base line."""
+    from ..core import fixed_math as fm  # numba: loaded when first needed
+    angle = np.pi - np.arange(HALFROUND_CHORDS + 1) * (np.pi / HALFROUND_CHORDS)
+    px = x + radius + radius * fm.vcos(angle)
+    py = radius * fm.vsin(angle)
+    px[0], py[0], px[-1], py[-1] = x, 0.0, x + 2.0 * radius, 0.0
+    return np.column_stack([px, py]).tolist()
+
+
 def obstacle_points(kind, x, height, length=0.0):
-    """Interior vertices of one obstacle starting at x on the base line y = 0."""
+    """Interior vertices of one obstacle starting at x on the base line y = 0 (a half-round:
+    height is its radius)."""
     if kind == "step":
         return [[x, 0.0], [x, height]]
     if kind == "ramp":
@@ -63,6 +78,8 @@ def obstacle_points(kind, x, height, length=0.0):
     if kind == "bump":  # a trapezoid with 45 deg flanks and a flat top of `length`
         return [[x, 0.0], [x + height, height], [x + height + length, height],
                 [x + 2 * height + length, 0.0]]
+    if kind == "halfround":
+        return halfround_points(x, height)
     raise ValueError(kind)
 
 
@@ -112,8 +129,8 @@ def _check_ahead(x, ob, eq, pad_ground):
     if x < front:
         raise ValueError(
             f"terrain.position = {x:.4g} m puts the {ob['kind']} under the resting track (its ground "
-            f"side reaches x = {front:.4g} m at height {h:g} m): place it further ahead, or by "
-            "first_contact_time"
+            f"side reaches x = {front:.4g} m at height {h:g} m): place it further ahead"
+            + (", or by first_contact_time" if ob["kind"] in ("step", "block") else "")
         )
 
 
@@ -127,7 +144,7 @@ def rough_points(t):
     if t["kind"] == "profile":
         return rough.read_profile_csv(t["file"])
     return rough.random_profile(
-        t["length"], t["seed"], t.get("roughness_class"), t.get("rms"), wavelength_min=t["wavelength_min"],
+        t["length"], t["seed"], t.get("roughness_class"), rough.rms_of(t), wavelength_min=t["wavelength_min"],
         wavelength_max=t["wavelength_max"], dx=rough.SPACING, run_in=t["run_in"], blend=rough.BLEND,
     )
 
@@ -219,7 +236,9 @@ def build_ground(scenario, eq):
             raise ValueError(f"terrain obstacle {i} starts at x = {x:.4g} m, before the previous one ends "
                              f"({x_end:.4g} m)")
         new = [
-            [px, py + level] for px, py in obstacle_points(ob["kind"], x, ob["height"], ob.get("length", 0.0))
+            [px, py + level]
+            for px, py in obstacle_points(ob["kind"], x, ob.get("height", ob.get("radius")),
+                                          ob.get("length", 0.0))
         ]
         pts += new
         x_end = new[-1][0]
