@@ -41,9 +41,10 @@ def test_a_halfround_in_the_ground_and_in_a_sequence():
     ({"kind": "random", "rms_in": 0.0}, "terrain.rms_in = 0.0 is not allowed"),
 ])
 def test_bad_halfround_and_nrmm_terrains_are_one_line(terrain, message):
-    with pytest.raises((tb.ScenarioError, ValueError)) as e:   # ValueError: simulate says it as a ScenarioError
+    # placement is checked as the ground is built: a ValueError there, which simulate says as a ScenarioError
+    with pytest.raises((tb.ScenarioError, ValueError)) as e:
         sc = tb.Scenario.paper(terrain=terrain)
-        build_ground(sc, equilibrium(sc))   # placement is checked when the ground is built
+        build_ground(sc, equilibrium(sc))
     assert message in str(e.value) and "\n" not in str(e.value)
 
 
@@ -53,8 +54,9 @@ def test_nrmm_rms_in_inches_is_the_rms_below_60_ft():
     sc = tb.Scenario.paper(terrain={"kind": "random", "rms_in": 1.0, "length": 200.0})
     t = sc["terrain"]
     assert t["wavelength_max"] == pytest.approx(18.288) and rough.rms_of(t) == pytest.approx(0.0254)
-    x, h = rough.random_profile(t["length"], t["seed"], rms=rough.rms_of(t), wavelength_min=t["wavelength_min"],
-                                wavelength_max=t["wavelength_max"], run_in=0.0, blend=0.0)
+    x, h = rough.random_profile(t["length"], t["seed"], rms=rough.rms_of(t),
+                                wavelength_min=t["wavelength_min"], wavelength_max=t["wavelength_max"],
+                                run_in=0.0, blend=0.0)
     assert np.sqrt(np.mean(h[:-1] ** 2)) == pytest.approx(0.0254, rel=1e-9)
     given = tb.Scenario.paper(terrain={"kind": "random", "rms_in": 1.0, "wavelength_max": 10.0})
     assert given["terrain"]["wavelength_max"] == 10.0
