@@ -104,11 +104,15 @@ def statics(sc):
 
 
 def _return_run_sag(st, sc):
-    """The return run: the pins above every road wheel's top; its sag: the largest drop of a pin
-    below the straight line between the run's first and last pins."""
+    """The return run: the pins above every road wheel's top between the sprocket's and the
+    idler's axes; its sag: the largest drop of a pin below the straight line between the
+    run's first and last pins."""
     reach = np.asarray(sc["vehicle.wheel_radius"], float) + sc["track.pad_wheel"]
     top = float(np.max(st.wheels[:, 1] + reach))
-    run = st.pins[st.pins[:, 1] > top]
+    parts = closed_drawing(st)
+    lo, hi = sorted((parts["sprocket"][0], parts["idler"][0]))
+    p = st.pins
+    run = p[(p[:, 1] > top) & (p[:, 0] > lo) & (p[:, 0] < hi)]
     if len(run) < 3:
         return 0.0
     run = run[np.argsort(run[:, 0])]
@@ -129,14 +133,15 @@ def describe(st):
         "of the weight",
         f"{'wheel':>5s} {'load kN':>9s} {'share':>7s} {'torsion N m':>12s} {'centre x, y (m)':>18s}",
     ]
+    carried = float(np.sum(eq.wheel_load))
     for i, (load, tq, (x, y)) in enumerate(zip(eq.wheel_load, eq.preload, st.wheels)):
         lines.append(
-            f"{i + 1:5d} {load / 1e3:9.2f} {100 * load / eq.weight:6.1f}% {tq:12.0f} {x:9.3f}, {y:.3f}"
+            f"{i + 1:5d} {load / 1e3:9.2f} {100 * load / carried:6.1f}% {tq:12.0f} {x:9.3f}, {y:.3f}"
         )
-    carried = float(np.sum(eq.wheel_load))
     lines.append(
-        f"wheels carry {carried / 1e3:.2f} kN of the weight {eq.weight / 1e3:.2f} kN "
-        f"({eq.weight / g / 1e3:.3f} t)"
+        f"the ground carries {eq.ground_force / 1e3:.2f} kN, the weight {eq.weight / 1e3:.2f} kN "
+        f"({eq.weight / g / 1e3:.3f} t); the wheels {carried / 1e3:.2f} kN (the weight and the "
+        "track's tension pressing them)"
     )
     t = eq.tension
     lines.append(
