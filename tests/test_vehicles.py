@@ -161,7 +161,7 @@ def test_vehicle_show_prints_the_statics_and_draws(six, tmp_path):
     assert "return run sag" in res.stdout and "ground pressure" in res.stdout and "seat" in res.stdout
     assert (tmp_path / "six_vehicle.png").stat().st_size > 10_000
     listing = subprocess.run(CLI + ["vehicles"], capture_output=True, text=True, timeout=300)
-    assert listing.returncode == 0 and "lee2000" in listing.stdout and "22.08 t" in listing.stdout
+    assert listing.returncode == 0 and "22.08 t" in listing.stdout and "m113" in listing.stdout
 
 
 BAD = {
@@ -202,3 +202,20 @@ def test_a_bad_vehicle_stops_a_run_before_it_writes(tmp_path):
                          capture_output=True, text=True, timeout=300)
     assert res.returncode == 2 and "vehicle.wheel_radius has 2 values" in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
+
+
+def test_m113_stands_on_one_track_and_its_track_closes():
+    """The M113 (Chrono's M113a, one track): about half its 9.15 t, the ground carries the
+    weight, every wheel is loaded, the 63 shoes close round sprocket and idler with the idler
+    within its travel and the tensioner near Chrono's 5e4 N preload."""
+    from trackbench.run.vehicle_report import statics, vehicle_mass, vehicle_scenario
+
+    sc = vehicle_scenario("m113")
+    assert 4.5e3 < vehicle_mass(sc) < 4.65e3 and sc["track.n_links"] == 63
+    st = statics(sc)
+    eq = st.eq
+    assert abs(eq.ground_force - eq.weight) < 1e-3 * eq.weight
+    assert np.all(eq.wheel_load > 0.0) and eq.residual < 1e-9 * eq.weight
+    assert abs(eq.info["idler_slide"]) < sc["idler.travel"]
+    assert 2e4 < eq.info["idler_force"] < 6e4
+    assert 30e3 < st.ground_pressure < 60e3     # published: 7.3 psi (50 kPa) at 10.4 t on two tracks
