@@ -219,3 +219,23 @@ def test_m113_stands_on_one_track_and_its_track_closes():
     assert abs(eq.info["idler_slide"]) < sc["idler.travel"]
     assert 2e4 < eq.info["idler_force"] < 6e4
     assert 30e3 < st.ground_pressure < 60e3     # published: 7.3 psi (50 kPa) at 10.4 t on two tracks
+
+
+def test_a_grid_over_vehicles_resolves_each(six):
+    from trackbench.study import load_study
+
+    (six / "grid.toml").write_text('[study]\nname = "fleet"\n\n[scenario]\nduration = 0.05\n\n'
+                                   '[grid]\n"vehicle.model" = ["lee2000", "six.toml", "m113"]\n')
+    study = load_study(six / "grid.toml", output=six / "fleet")
+    wheels = [r.scenario["vehicle"]["n_wheels"] for r in study.runs]
+    assert wheels == [5, 6, 5] and study.runs[2].scenario["track"]["n_links"] == 63
+    assert study.runs[0].scenario["track"] == paper_track()
+
+
+def test_a_vehicle_without_an_equilibrium_stops_vehicle_show_in_one_line(six, tmp_path):
+    (tmp_path / "wobbly.toml").write_text(SIX.replace("arm_angle = [44.0,", "arm_angle = [40.0,")
+                                          .replace("45.0, 44.0]", "45.0, 40.0]"))
+    res = subprocess.run(CLI + ["vehicle", "show", "wobbly.toml"], cwd=tmp_path, capture_output=True,
+                         text=True, timeout=600)
+    assert res.returncode == 1 and "the vehicle does not stand" in res.stderr, res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1 and not list(tmp_path.glob("*.png"))
