@@ -151,6 +151,9 @@ def test_a_users_vehicle_runs_a_closed_track_study(six):
     for r in runs:
         info = json.loads(r.read_text())
         assert info["status"] == "completed", info
+    # the resolved copy carries every value: it loads beside the results, reading no vehicle file
+    copy = load_study(six / "results" / "study.toml", output=six / "again")
+    assert [r.scenario["vehicle"] for r in copy.runs] == [r.scenario["vehicle"] for r in study.runs]
 
 
 def test_vehicle_show_prints_the_statics_and_draws(six, tmp_path):

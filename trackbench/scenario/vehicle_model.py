@@ -32,13 +32,18 @@ def vehicle_defaults():
 def apply_model(d, model, explicit, folder=None):
     """The vehicle file's values into d (resolved scenario tables) for every name of its
     groups not in explicit (a name the file leaves out: the paper's value); returns the names
-    the file gives values other than the paper's."""
+    the file gives values other than the paper's. A scenario that sets every such name itself
+    (a resolved one: a study's resolved copy, a run's scenario) keeps the name as a label and
+    reads no file."""
+    defaults = vehicle_defaults()
+    if all(name in explicit for name in defaults):
+        d["vehicle"]["model"] = model
+        return frozenset()
     try:
         vf = read(model, folder)
     except VehicleError as e:
         raise ScenarioError(str(e)) from None
     _check_alone(vf)
-    defaults = vehicle_defaults()
     for name, default in defaults.items():
         if name not in explicit:
             set_dotted(d, name, copy.deepcopy(vf.values.get(name, default)))
