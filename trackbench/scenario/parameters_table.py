@@ -8,14 +8,7 @@ from trackbench.scenario.presets import PRESETS
 from ..model.contact.laws import DAMPINGS, FRICTION_LAWS, GEOMETRIES, LAWS
 from ..model.core.indices import DRIVES
 from ..model.ground.rough import CLASSES
-from ..model.vehicle.parameters import (
-    GRAVITY,
-    PER_WHEEL,
-    closed_defaults,
-    paper_contact,
-    paper_track,
-    paper_vehicle,
-)
+from ..model.vehicle.parameters import GRAVITY, closed_defaults, paper_contact, paper_track, paper_vehicle
 from ..solvers.registry import METHODS
 from ..solvers.registry import SOLVERS as _REGISTRY
 
@@ -319,6 +312,8 @@ def parameter_names():
 
 
 # --- real vehicles as data (trackbench/vehicles/, scenario/vehicle_model.py) ---------------
+from ..model.vehicle.parameters import PER_WHEEL  # noqa: E402  (this block's own, for merging)
+
 # vehicle.model names a vehicle file: a catalogue name or a path. No default: a scenario
 # without it keeps every name and value it had (its study run ids with them).
 RULES["vehicle.model"] = (str, None, None, "a catalogue name (trackbench vehicles) or a vehicle file (.toml)")
