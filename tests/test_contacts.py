@@ -7,7 +7,13 @@ from trackbench.model.core import indices as L
 from trackbench.model.core.bundles import arm_table, model_arrays, work_arrays
 from trackbench.model.dynamics.track_loads import track_loads
 from trackbench.model.ground.terrain import ground_from_points
-from trackbench.model.vehicle.parameters import pack, paper_contact, paper_track, paper_vehicle
+from trackbench.model.vehicle.parameters import (
+    pack,
+    paper_contact,
+    paper_track,
+    paper_vehicle,
+    station_columns,
+)
 from trackbench.status import CORNER_THROUGH_TRACK, WHEEL_THROUGH_TRACK
 
 K = 1e8  # k_w = k_g of the paper
@@ -25,7 +31,8 @@ def loads(pins, wheels, ground=((-1000, 0.0), (1000, 0.0)), velocities=None, geo
     tr["n_links"] = len(pins) - 1
     par, piv, ends = pack(v, tr, 9.81, {**paper_contact(), "geometry": geometry})
     g = ground_from_points(ground)
-    m = model_arrays(par, arm_table(piv, 0.0, 0.0), ends, g.segments, g.corners, len(pins) - 1)
+    arms = arm_table(piv, 0.0, 0.0, station_columns(v, tr))
+    m = model_arrays(par, arms, ends, g.segments, g.corners, len(pins) - 1)
     w = work_arrays(m, len(wheels), len(pins) - 1)
     w.apos[:] = pins
     w.wc[:] = wheels

@@ -104,6 +104,46 @@ def params() -> None:
     typer.echo(parameter_table())
 
 
+# --- vehicles ------------------------------------------------------------------------
+
+vehicle_app = typer.Typer(no_args_is_help=True, cls=_Group, help="One vehicle file: its state at rest.")
+app.add_typer(vehicle_app, name="vehicle")
+
+
+@app.command(cls=_Command)
+def vehicles() -> None:
+    """List the vehicle catalogue: name, mass, road wheels, track layout, description and source."""
+    from trackbench.run.vehicle_report import catalogue_table
+    from trackbench.scenario import ScenarioError
+    try:
+        typer.echo(catalogue_table())
+    except ScenarioError as e:
+        _fail(str(e))
+
+
+@vehicle_app.command("show", cls=_Command)
+def vehicle_show(
+    model: str = typer.Argument(
+        ..., help="A catalogue name (trackbench vehicles) or a vehicle file (.toml)."
+    ),
+    out: Path = typer.Option(Path("."), "--out", "-o", help="Folder for the side view NAME_vehicle.png."),
+) -> None:
+    """Print a vehicle's static equilibrium (wheel loads, track tension and sag, ground pressure,
+    seat height) and write its side view, the parts named."""
+    from trackbench.figures.vehicle_figure import vehicle_figure
+    from trackbench.run.vehicle_report import describe, statics, vehicle_scenario
+    from trackbench.scenario import ScenarioError
+    from trackbench.status import EquilibriumError
+    try:
+        st = statics(vehicle_scenario(model))
+    except ScenarioError as e:
+        _fail(str(e))
+    except EquilibriumError as e:
+        _fail(f"vehicle.model = '{model}': the vehicle does not stand: {e}", 1)
+    typer.echo(describe(st))
+    typer.echo(f"written: {vehicle_figure(st, out / (Path(model).stem + '_vehicle.png'))}")
+
+
 # --- study commands ----------------------------------------------------------------
 
 def _load_study_or_fail(file: Path, output: Optional[Path] = None) -> Study:

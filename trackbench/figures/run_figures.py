@@ -32,7 +32,7 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False, for
 
     g = G.side_view(ds, [i])
     pins, wheels = g["pins"][0], g["wheels"][0]
-    r = float(ds.attrs["wheel_radius"])
+    radii = G.wheel_radii(ds)
     if x_range is None:
         x_range = (min(pins[:, 0].min(), g["chassis"][0][:, 0].min()) - 0.4,
                    max(pins[:, 0].max(), g["chassis"][0][:, 0].max()) + 0.4)
@@ -68,7 +68,7 @@ def draw_configuration(ax, ds, i, x_range=None, arrows=True, colorbar=False, for
         ax.plot([px, wx], [py, wy], color="#6e6e6e", lw=3, zorder=3, solid_capstyle="round")
         ax.plot([px], [py], "o", color="#3c3c3c", ms=3, zorder=4)
     for k, (wx, wy) in enumerate(wheels):
-        ax.add_patch(Circle((wx, wy), r, facecolor="#f4f4f4", edgecolor="#222222", lw=1.3, zorder=3))
+        ax.add_patch(Circle((wx, wy), radii[k], facecolor="#f4f4f4", edgecolor="#222222", lw=1.3, zorder=3))
         ax.text(
             wx, wy + 0.02, str(int(ds["wheel"].values[k])), ha="center", va="center", fontsize=7, zorder=6
         )

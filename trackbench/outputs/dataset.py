@@ -258,7 +258,19 @@ def _attrs(scenario, model, eq, ground, resolved, st, wall_time, solve_time):
         "arm_length": float(model.par[L.P_ARM_LENGTH]),
         "pad_wheel": float(model.par[L.P_PAD_WHEEL]),
         "pad_ground": float(model.par[L.P_PAD_GROUND]),
+        **_station_attrs(model),
     }
+
+
+def _station_attrs(model):
+    """Each road wheel's radius and arm length (JSON lists) where the wheels differ; where they
+    are alike, wheel_radius and arm_length say it (and the attributes stay as they were)."""
+    out = {}
+    for name, col in (("wheel_radii", L.ARMS_RADIUS), ("arm_lengths", L.ARMS_LENGTH)):
+        values = model.arms[:, col]
+        if np.any(values != values[0]):
+            out[name] = json.dumps(values.tolist())
+    return out
 
 
 def build_dataset(scenario, model, eq, ground, resolved, result, wall_time, solve_time):

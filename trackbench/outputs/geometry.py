@@ -163,10 +163,18 @@ def closed_parts(lay, outline, x, y, pitch, sprocket_angle, idler_x, idler_y):
     }
 
 
+def wheel_radii(ds):
+    """Each road wheel's radius (m), front to rear: the attribute wheel_radii where the wheels
+    differ, else wheel_radius for every wheel."""
+    if "wheel_radii" in ds.attrs:
+        return np.asarray(attr_json(ds, "wheel_radii"), float)
+    return np.full(ds.sizes["wheel"], float(ds.attrs["wheel_radius"]))
+
+
 def covered_x_range(ds, block=8192):
     """x range the track covers during the run, with GROUND_MARGIN each side (read block by
     block of samples: a long run's file opened lazily is never read whole)."""
-    r = float(ds.attrs["wheel_radius"])
+    r = float(wheel_radii(ds).max())
     n = ds.sizes["time"]
     lo, hi = np.inf, -np.inf
     for a in range(0, max(n, 1), block):
@@ -187,7 +195,7 @@ def follow_window(ds):
         return None
     x0 = float(ds.variables["chassis_x"].values[0])
     first = ds.isel(time=0)
-    r = float(ds.attrs["wheel_radius"])
+    r = float(wheel_radii(ds).max())
     px, wx = first.variables["pin_x"].values, first.variables["wheel_x"].values
     left = min(float(np.nanmin(px)), float(np.nanmin(wx)) - r)
     right = max(float(np.nanmax(px)), float(np.nanmax(wx)) + r)
@@ -342,7 +350,7 @@ def side_view(ds, idx=None):
     f = np.stack([take("wheel_force_x"), take("wheel_force_y")], axis=-1)
     mag = np.hypot(f[..., 0], f[..., 1])
     unit = np.where(mag[..., None] > 0.0, f / np.where(mag > 0.0, mag, 1.0)[..., None], np.array([0.0, 1.0]))
-    reach = float(ds.attrs["wheel_radius"]) + float(ds.attrs["pad_wheel"])
+    reach = (wheel_radii(ds) + float(ds.attrs["pad_wheel"]))[:, None]
     out = {
         "time": take("time"),
         "chassis": chassis,

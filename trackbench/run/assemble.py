@@ -11,7 +11,7 @@ import numpy as np
 from trackbench.model.contact.laws import bristle_active
 from trackbench.model.core import indices as L
 from trackbench.model.core.bundles import arm_table, model_arrays, work_arrays
-from trackbench.model.vehicle.parameters import arm_damping, pack, total_mass
+from trackbench.model.vehicle.parameters import arm_damping, pack, station_columns, total_mass
 from trackbench.scenario import Scenario
 
 
@@ -170,7 +170,7 @@ class Model:
         par, piv, ends = pack(v, tr, scenario["gravity"], scenario["contact"])
         self.nw = int(v["n_wheels"])
         self.n_links = int(tr["n_links"])
-        arms = arm_table(piv, eq.phi0, arm_damping(v))
+        arms = arm_table(piv, eq.phi0, arm_damping(v), station_columns(v, tr))
         parts = closed_parts(scenario)
         self.closed_parts = parts   # (geometry, LP_* vector, guide table) of the closed layout, or None
         self.closed = parts is not None

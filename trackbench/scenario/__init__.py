@@ -9,7 +9,7 @@ area are check_*.py.
 
 import copy
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 
@@ -27,6 +27,7 @@ from .parameters_table import (  # noqa: E402
     METHODS,
     OBSTACLE_KINDS,
     OPEN_LOW,
+    PER_WHEEL_NAMES,
     PLACEMENT_KEYS,
     RULES,
     SOLVERS,
@@ -36,6 +37,7 @@ from .parameters_table import (  # noqa: E402
     paper_step,
     parameter_names,
 )
+from .vehicle_model import apply_model, per_wheel_lists, take_model  # noqa: E402
 
 __all__ = [
     "Scenario",
@@ -60,10 +62,14 @@ __all__ = [
 @dataclass(frozen=True)
 class Scenario:
     """A validated, fully resolved scenario. Build with from_dict or paper().
-    explicit: the dotted names set by the user rather than by defaults or a preset."""
+    explicit: the dotted names set by the user rather than by defaults or a preset; given:
+    those its vehicle file (vehicle.model) sets to other than the paper's values; folder:
+    where a relative vehicle file is sought (a study file's folder; None: the current one)."""
 
     data: dict[str, Any]
     explicit: frozenset[str] = frozenset()
+    given: frozenset[str] = frozenset()
+    folder: str | None = field(default=None, compare=False)
 
     @classmethod
     def paper(cls, **overrides: Any) -> "Scenario":
@@ -71,10 +77,13 @@ class Scenario:
 
     @classmethod
     def from_dict(cls, overrides: Mapping[str, Any] | None = None, base: Mapping[str, Any] | None = None,
-                  explicit: frozenset[str] | None = None) -> "Scenario":
+                  explicit: frozenset[str] | None = None, given: frozenset[str] = frozenset(),
+                  folder: str | None = None) -> "Scenario":
         """Defaults (the paper's run, or ``base``) updated by ``overrides``; keys may be
         nested tables or dotted names. A base given as a plain dict counts as explicit
-        throughout (it is a resolved scenario: its preset values stay as they are)."""
+        throughout (it is a resolved scenario: its preset values stay as they are).
+        vehicle.model among the overrides: its file's values become the defaults of the
+        vehicle's groups (scenario/vehicle_model.py), relative files sought in ``folder``."""
         d: dict[str, Any] = copy.deepcopy(dict(base) if base is not None else paper_step())
         if explicit is None:
             explicit = frozenset(flatten(d)) if base is not None else frozenset()
@@ -86,15 +95,19 @@ class Scenario:
                 if k not in RULES:
                     raise unknown(k, parameter_names())
             set_dotted(nested, k, v)
+        model = take_model(nested)
+        if model is not None:
+            given = apply_model(d, model, explicit | dotted_keys(nested), folder)
         merge(d, nested)
-        explicit = frozenset(explicit | dotted_keys(nested))
+        explicit = frozenset(explicit | dotted_keys(nested) | ({"vehicle.model"} if model else set()))
         d["preset"] = check_value("preset", d.get("preset"), RULES["preset"])
         apply_sampling(d, explicit)   # first: the paper preset's step cap follows the output interval
-        apply_preset(d, explicit)
-        return cls(validate(d, explicit), explicit)
+        apply_preset(d, explicit | given)
+        return cls(validate(d, explicit | given), explicit, given, folder)
 
     def with_overrides(self, overrides: Mapping[str, Any]) -> "Scenario":
-        return Scenario.from_dict(overrides, base=self.data, explicit=self.explicit)
+        return Scenario.from_dict(overrides, base=self.data, explicit=self.explicit, given=self.given,
+                                  folder=self.folder)
 
     def to_dict(self) -> dict[str, Any]:
         return copy.deepcopy(self.data)
@@ -118,7 +131,10 @@ def validate(d: Mapping[str, Any], explicit: frozenset[str] = frozenset()) -> di
     for name, value in flat.items():
         if name not in RULES:
             raise unknown(name, parameter_names())
+        if name in PER_WHEEL_NAMES and isinstance(value, (list, tuple)):
+            continue   # one per wheel: checked once the wheel count is
         set_dotted(out, name, check_value(name, value, RULES[name], name in OPEN_LOW))
+    per_wheel_lists(out)
     check_solver(out)
     out["terrain"] = validate_terrain(d["terrain"])
     check_sampling(out)

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..model.vehicle.parameters import equilibrium_arm_angle, pivots
+from ..model.vehicle.parameters import per_wheel, wheel_centres_with
 from . import ScenarioError
 
 
@@ -16,8 +16,7 @@ def wheel_centres_for_checks(v):
     but with the C library's cos and sin: a check decides no number of a result, and the
     compiled elementary functions would load numba (about 0.8 s) into every command that only
     validates (`study status`, the coordinator of `study run`)."""
-    phi = equilibrium_arm_angle(v)
-    return pivots(v) + v["arm_length"] * np.array([math.cos(phi), math.sin(phi)])
+    return wheel_centres_with(v, math.cos, math.sin)
 
 
 def check_geometry(v, tr):
@@ -32,19 +31,47 @@ def check_geometry(v, tr):
 def _check_geometry(key):
     v, tr = json.loads(key)
     wc = wheel_centres_for_checks(v)
-    r = v["wheel_radius"]
+    r = per_wheel(v, "wheel_radius")
+    _check_wheels_apart(v, wc, r)
+    _check_stands(v, wc)
     rho = r + tr["pad_wheel"]
-    if v["n_wheels"] > 1 and v["pivot_spacing"] <= 2 * r:
-        raise ScenarioError(
-            f"vehicle.pivot_spacing = {v['pivot_spacing']} m makes neighbouring road wheels overlap: "
-            f"it must exceed 2 * wheel_radius = {2 * r} m"
-        )
     ends = _track_ends(v, tr, wc, rho)
     if tr["link_length"] <= 2 * tr["pad_ground"]:
         raise ScenarioError("track.link_length must exceed 2 * track.pad_ground")
     if tr["layout"] == "closed":
         return
     _check_track_length(ends, wc, rho, tr)
+
+
+def _check_wheels_apart(v, wc, r):
+    """Neighbouring road wheels must not overlap (nor swap places) at the initial equilibrium."""
+    spacing = v["pivot_spacing"]
+    if not isinstance(spacing, list) and all(not isinstance(v[k], list) for k in (
+            "wheel_radius", "arm_length", "arm_angle", "pivot_y")) and spacing <= 2 * r[0]:
+        raise ScenarioError(
+            f"vehicle.pivot_spacing = {spacing} m makes neighbouring road wheels overlap: "
+            f"it must exceed 2 * wheel_radius = {2 * r[0]} m"
+        )
+    d = np.hypot(*np.diff(wc, axis=0).T)
+    for i in range(len(d)):
+        if wc[i + 1, 0] >= wc[i, 0] or d[i] <= r[i] + r[i + 1]:
+            raise ScenarioError(
+                f"road wheels {i + 1} and {i + 2} overlap: their centres lie {d[i]:.4g} m apart, within "
+                f"their radii's sum {r[i] + r[i + 1]:.4g} m (wheel {i + 2} must lie behind wheel {i + 1}); "
+                "allowed: vehicle.pivot_spacing, arm_length, arm_angle and wheel_radius that keep them apart"
+            )
+
+
+def _check_stands(v, wc):
+    """The chassis' mass centre (x = 0 of the body frame) must lie over the wheels' span, or
+    the vehicle tips over at rest: no static equilibrium on level ground."""
+    lo, hi = float(wc[:, 0].min()), float(wc[:, 0].max())
+    if not lo < 0.0 < hi:
+        raise ScenarioError(
+            f"the vehicle does not stand: its mass centre (x = 0) lies outside the road wheels' span "
+            f"[{lo:.3g}, {hi:.3g}] m; allowed: vehicle.first_pivot_x and pivot_spacing that put wheels "
+            "ahead of and behind it"
+        )
 
 
 def _track_ends(v, tr, wc, rho):
@@ -54,12 +81,12 @@ def _track_ends(v, tr, wc, rho):
         if len(e) != 2 or not all(isinstance(x, (int, float)) and math.isfinite(x) for x in e):
             raise ScenarioError(f"vehicle.{key} must be a pair [x, y] of finite numbers (m)")
     ends = np.array([v["front_track_end"], v["rear_track_end"]], float)
-    if not (ends[0, 0] > wc[:, 0].max() + rho and ends[1, 0] < wc[:, 0].min() - rho):
+    if not (ends[0, 0] > (wc[:, 0] + rho).max() and ends[1, 0] < (wc[:, 0] - rho).min()):
         raise ScenarioError(
             "vehicle.front_track_end / rear_track_end must lie ahead of the first and behind the "
             "last road wheel (wheel radius and pad included)"
         )
-    if np.any(ends[:, 1] <= wc[:, 1].min() - rho + tr["pad_ground"]):
+    if np.any(ends[:, 1] <= (wc[:, 1] - rho).min() + tr["pad_ground"]):
         raise ScenarioError(
             "vehicle.front_track_end / rear_track_end must lie above the bottom of the road wheels"
         )
@@ -90,6 +117,7 @@ def _taut_length(ends, wc, rho):
     from ..model.vehicle.track_path import _lower_hull  # plain numpy; no compiled code
 
     ang = np.linspace(0.0, 2 * np.pi, 361)[:-1]
-    circ = [c + rho * np.column_stack([np.cos(ang), np.sin(ang)]) for c in wc]
+    ring = np.column_stack([np.cos(ang), np.sin(ang)])
+    circ = [c + r * ring for c, r in zip(wc, np.broadcast_to(rho, (len(wc),)))]
     hull = _lower_hull(np.vstack([ends] + circ))
     return float(np.hypot(*np.diff(hull, axis=0).T).sum())

@@ -319,3 +319,21 @@ OBSTACLE_KEYS = {
 def parameter_names():
     """Every dotted name a scenario accepts (terrain keys included)."""
     return sorted(RULES) + sorted("terrain." + k for k in TERRAIN_RULES)
+
+
+# --- real vehicles as data (trackbench/vehicles/, scenario/vehicle_model.py) ---------------
+from ..model.vehicle.parameters import PER_WHEEL  # noqa: E402  (this block's own, for merging)
+
+# vehicle.model names a vehicle file: a catalogue name or a path. No default: a scenario
+# without it keeps every name and value it had (its study run ids with them).
+RULES["vehicle.model"] = (str, None, None, "a catalogue name (trackbench vehicles) or a vehicle file (.toml)")
+# the groups a vehicle file sets (its values are the scenario's defaults; explicit ones win)
+VEHICLE_GROUPS = ("vehicle", "track", "sprocket", "idler", "rollers")
+# values that may differ from road wheel to road wheel: a list, front to rear, or one number for
+# every wheel (model/vehicle/parameters.PER_WHEEL); pivot_spacing: one per gap between neighbours
+PER_WHEEL_NAMES = tuple("vehicle." + k for k in PER_WHEEL)
+for _name in PER_WHEEL_NAMES:
+    _t, _lo, _hi, _text = RULES[_name]
+    _each = "one per gap between neighbouring wheels" if _name == "vehicle.pivot_spacing" else (
+        "one per road wheel, front to rear")
+    RULES[_name] = (_t, _lo, _hi, f"{_text}, or a list of them ({_each})")

@@ -5,6 +5,7 @@ moved more than the skin."""
 from numba import njit
 
 from ..core.indices import (
+    ARMS_REACH,
     C_CORNER_END,
     C_CORNER_FIRST,
     C_OVERFLOW,
@@ -22,7 +23,6 @@ from ..core.indices import (
     P_PAD_GROUND,
     P_PAD_WHEEL,
     P_SKIN,
-    P_WHEEL_RADIUS,
     PN_LAST,
     SEG_LENGTH,
     SEG_X0,
@@ -151,9 +151,9 @@ def build_neighbours(apos, wc, gc, m):
     last = m.pins[PN_LAST]
     skin = par[P_SKIN]
     hg = par[P_PAD_GROUND]
-    reach_w = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL] + skin
     reach_cl = max(hg, par[P_PAD_WHEEL]) + skin
     for i in range(wc.shape[0]):
+        reach_w = m.arms[i, ARMS_REACH] + skin   # wheel radius + pad h_w, the station's own
         _near_links(wc[i, 0], wc[i, 1], apos, reach_w, nbr, rows[K_WHEEL_LINK] + i)
         _near_pins(wc[i, 0], wc[i, 1], apos, last, reach_w, nbr, rows[K_WHEEL_PIN] + i)
     for j in range(gc.shape[0]):

@@ -14,6 +14,7 @@ from numba import njit
 
 from ...status import WHEEL_THROUGH_TRACK
 from ..core.indices import (
+    ARMS_REACH,
     C_EVALUATIONS,
     D_DISSIPATION,
     D_E_PAD_WHEEL,
@@ -34,9 +35,7 @@ from ..core.indices import (
     P_DAMPING_RAMP,
     P_K_GROUND,
     P_K_WHEEL,
-    P_PAD_WHEEL,
     P_RESTITUTION_FACTOR,
-    P_WHEEL_RADIUS,
 )
 from ..core.jit import BORROW, INLINE
 from .gaps import pin_cap_weight, point_on_link
@@ -244,9 +243,9 @@ def wheel_contacts(w, m, diag, mem):
     par = m.par
     law = contact_law(par, P_C_WHEEL)
     continuous = par[P_CONTACT_GEOMETRY] == GEOMETRY_CONTINUOUS
-    rho = par[P_WHEEL_RADIUS] + par[P_PAD_WHEEL]
     acc = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     for i in range(w.fwheel.shape[0]):
+        rho = m.arms[i, ARMS_REACH]   # wheel radius + pad h_w, the station's own
         probe = (w.wc[i, 0], w.wc[i, 1], w.wv[i, 0], w.wv[i, 1])
         rows = (m.nbr_rows[K_WHEEL_LINK] + i, m.nbr_rows[K_WHEEL_PIN] + i)
         acc = round_on_track(probe, rho, rows, w, m, law, continuous, mem, diag, acc)

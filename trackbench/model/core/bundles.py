@@ -14,7 +14,8 @@ from . import indices as L
 # refreshes as the track moves, and the counters.
 ModelArrays = namedtuple("ModelArrays", [
     "par",        # (N_PAR,) scalar parameters, P_*
-    "arms",       # (n_wheels, N_ARMS_COLS) pivot body point, torsion-bar free angle, damper (ARMS_*)
+    "arms",       # (n_wheels, N_ARMS_COLS) per station: pivot body point, torsion-bar free angle, damper,
+                  # arm length, wheel reach, masses, stiffness (ARMS_*)
     "ends",       # (2, 2) track-end body points: front (pin 0), rear (pin n_links)
     "seg",        # (n_segments, N_SEG_COLS) ground segments, SEG_*
     "corners",    # (n_corners, 2) convex ground corners
@@ -43,7 +44,8 @@ Work = namedtuple("Work", [
     "wv",         # (n_wheels, 2) road-wheel centre velocities
     "fwheel",     # (n_wheels, 2) out: contact force of the track on each wheel
     "lk",         # (n_links, 3) per link: unit direction t (pin b -> b+1) and length
-    "arm",        # (n_wheels, ARM_COLS) per arm: cos and sin of beta, the chassis coupling
+    "arm",        # (n_wheels, ARM_COLS + 1) per arm: cos and sin of beta, the chassis coupling, its
+                  # diagonal mass (ARM_D)
     "pair_seen",  # int (rows, width - 1): the evaluation (C_EVALUATIONS) that last found the pair
                   # in contact, for the laws that remember an approach speed
     "pair_rate",  # (rows, width - 1): its compression rate then
@@ -54,14 +56,18 @@ Work = namedtuple("Work", [
 
 ARM_BX, ARM_BY, ARM_BT, ARM_Q, ARM_COS, ARM_SIN = range(6)   # columns of Work.arm
 ARM_COLS = 6
+ARM_D = ARM_COLS   # Work.arm's and ClosedWork.extra's last column: the row's diagonal mass
 
 
-def arm_table(pivots, phi0, damping):
-    """The arms array: pivot body points, torsion-bar free angles, rotary dampers."""
+def arm_table(pivots, phi0, damping, stations):
+    """The arms array: pivot body points, torsion-bar free angles, rotary dampers, and each
+    station's own values ({ARMS_* column: values}, model/vehicle/parameters.station_columns)."""
     arms = np.zeros((len(pivots), L.N_ARMS_COLS))
     arms[:, [L.ARMS_PX, L.ARMS_PY]] = pivots
     arms[:, L.ARMS_PHI0] = phi0
     arms[:, L.ARMS_DAMPING] = damping
+    for col, values in stations.items():
+        arms[:, col] = values
     return arms
 
 
@@ -97,7 +103,7 @@ def work_arrays(m, n_wheels, n_links):
     closed = bool(m.pins[L.PN_CLOSED])
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
             np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)), np.zeros((n_wheels, 2)),
-            np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS)),
+            np.zeros((n_links + closed, L.N_LK_COLS)), np.zeros((n_wheels, ARM_COLS + 1)),
             np.full(m.v0.shape, -1, dtype=np.int64), np.zeros(m.v0.shape), np.zeros(n_pins),
             np.zeros((n_pins, L.N_GRIP)))
     if not closed:
@@ -120,7 +126,6 @@ ClosedWork = namedtuple("ClosedWork", list(Work._fields) + [
     "genf",       # (nq,) out: generalised forces at rest (no inertia terms) for the equilibrium
 ])
 LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of ClosedWork.extra
-ARM_D = ARM_COLS                   # column of ClosedWork.extra: the diagonal mass
 
 
 # Scratch of the event location (solvers/common/events.py): the configuration at both ends of

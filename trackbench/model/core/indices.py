@@ -260,6 +260,8 @@ C_OVERFLOW = 4           # 1 once a pin had more candidate segments than its row
 N_COUNTERS = 5
 
 # --- scalar parameters, ``par`` ---------------------------------------------------
+# P_ARM_MASS .. P_WHEEL_RADIUS hold road wheel 1's values; the kernels read each station's own
+# from the arm table (ARMS_*), where a vehicle's wheels may differ
 P_CHASSIS_MASS = 0
 P_CHASSIS_INERTIA = 1
 P_ARM_MASS = 2
@@ -313,12 +315,19 @@ G_SPEED = 2              # out: the pin's speed along it (m/s; 0 off the ground)
 G_RATE = 3               # out: dz/dt (m/s)
 N_GRIP = 4
 
-# --- columns of the arm table, ``arms`` ----------------------------------------------
+# --- columns of the arm table, ``arms``: one row per road-wheel station, front to rear --
 ARMS_PX = 0              # pivot body point
 ARMS_PY = 1
 ARMS_PHI0 = 2            # torsion-bar free angle
 ARMS_DAMPING = 3         # rotary damper of the station (N m s/rad)
-N_ARMS_COLS = 4
+ARMS_LENGTH = 4          # arm length, pivot to wheel centre (m)
+ARMS_REACH = 5           # wheel radius + pad h_w: where the track's centre line meets the wheel (m)
+ARMS_MASS = 6            # arm + road wheel (kg)
+ARMS_INERTIA = 7         # about the wheel centre (kg m^2)
+ARMS_STIFFNESS = 8       # torsion bar k_t (N m/rad)
+ARMS_DIAGONAL = 9        # the arm's diagonal mass about its pivot, m l^2 + I (kg m^2)
+ARMS_RADIUS = 10         # wheel radius (m)
+N_ARMS_COLS = 11
 
 # --- per-evaluation diagnostics, ``diag`` -------------------------------------------
 D_STATUS = 0             # 0 ok, else a Status code found in this evaluation

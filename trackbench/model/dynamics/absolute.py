@@ -28,9 +28,13 @@ from numba import njit
 
 from ..core import fixed_math as fm
 from ..core.indices import (
+    ARMS_INERTIA,
+    ARMS_LENGTH,
+    ARMS_MASS,
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    ARMS_STIFFNESS,
     D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
@@ -47,14 +51,10 @@ from ..core.indices import (
     LK_TX,
     LK_TY,
     N_J_ROWS,
-    P_ARM_INERTIA,
-    P_ARM_LENGTH,
-    P_ARM_MASS,
     P_CHASSIS_INERTIA,
     P_CHASSIS_MASS,
     P_GRAVITY,
     P_PIN_MASS,
-    P_TORSION_STIFFNESS,
     Q_ARM,
     Q_PITCH,
     Q_X,
@@ -75,14 +75,15 @@ from ..vehicle.kinematics import body_offset, wheel_offset
 from .track_loads import track_loads
 
 
-def inverse_mass(par, n_wheels, n_links):
+def inverse_mass(par, arms, n_links):
     """Diagonal of M^-1 (constant)."""
+    n_wheels = arms.shape[0]
     m = np.empty(n_absolute(n_wheels, n_links))
     m[[Z_X, Z_Y]] = par[P_CHASSIS_MASS]
     m[Z_PITCH] = par[P_CHASSIS_INERTIA]
     for i in range(n_wheels):
-        m[z_arm(i) + ZA_X] = m[z_arm(i) + ZA_Y] = par[P_ARM_MASS]
-        m[z_arm(i) + ZA_BETA] = par[P_ARM_INERTIA]
+        m[z_arm(i) + ZA_X] = m[z_arm(i) + ZA_Y] = arms[i, ARMS_MASS]
+        m[z_arm(i) + ZA_BETA] = arms[i, ARMS_INERTIA]
     m[z_pin(n_wheels):] = par[P_PIN_MASS]
     return 1.0 / m
 
@@ -94,7 +95,6 @@ def from_reduced(y, par, arms, z, zd):
     nw = arms.shape[0]
     nq = nq_of(y.shape[0])
     nb = z_pin(nw)
-    la = par[P_ARM_LENGTH]
     th = y[Q_PITCH]
     om = y[nq + Q_PITCH]
     s, c = fm.sincos(th)
@@ -102,6 +102,7 @@ def from_reduced(y, par, arms, z, zd):
         z[k] = y[k]
         zd[k] = y[nq + k]
     for i in range(nw):
+        la = arms[i, ARMS_LENGTH]
         beta = th + y[Q_ARM + i]
         bd = om + y[nq + Q_ARM + i]
         sb, cb = fm.sincos(beta)
@@ -144,9 +145,9 @@ def to_reduced(z, zd, work, nw, y):
 def joint_vectors(z, par, arms, geo):
     """Per joint i: geo[i] = (r_x, r_y, l cos beta, l sin beta) with r = R(theta) p_i.
     Then dr_i = (-r_y, r_x) and d(l e_i)/d beta = (-l sin beta, l cos beta)."""
-    la = par[P_ARM_LENGTH]
     s, c = fm.sincos(z[Z_PITCH])
     for i in range(arms.shape[0]):
+        la = arms[i, ARMS_LENGTH]
         geo[i, GEO_RX], geo[i, GEO_RY] = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
         beta = z[z_arm(i) + ZA_BETA]
         geo[i, GEO_LX] = la * fm.cos(beta)
@@ -282,7 +283,6 @@ def applied_forces(z, zd, m, w, F, fc, diag):
     _place_absolute(z, zd, m.ends, w)
     track_loads(w, m, diag)
     g = par[P_GRAVITY]
-    kt = par[P_TORSION_STIFFNESS]
     F[Z_X] = fpin[0, 0] + fpin[n_pins - 1, 0]
     F[Z_Y] = fpin[0, 1] + fpin[n_pins - 1, 1] - par[P_CHASSIS_MASS] * g
     tq = 0.0
@@ -291,10 +291,10 @@ def applied_forces(z, zd, m, w, F, fc, diag):
         tq += (apos[b, 0] - z[Z_X]) * fpin[b, 1] - (apos[b, 1] - z[Z_Y]) * fpin[b, 0]
     for i in range(nw):
         j = z_arm(i)
-        tors = -kt * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0])
+        tors = -arms[i, ARMS_STIFFNESS] * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0])
         tq -= tors
         F[j + ZA_X] = fwheel[i, 0]
-        F[j + ZA_Y] = fwheel[i, 1] - par[P_ARM_MASS] * g
+        F[j + ZA_Y] = fwheel[i, 1] - arms[i, ARMS_MASS] * g
         F[j + ZA_BETA] = tors
     F[Z_PITCH] = tq
     mg = par[P_PIN_MASS] * g
@@ -332,17 +332,16 @@ def finish_diag(z, zd, zdd, par, arms, power, diag):
     nw = arms.shape[0]
     nb = z_pin(nw)
     g = par[P_GRAVITY]
-    kt = par[P_TORSION_STIFFNESS]
     ke = (0.5 * par[P_CHASSIS_MASS] * (zd[Z_X] ** 2 + zd[Z_Y] ** 2)
           + 0.5 * par[P_CHASSIS_INERTIA] * zd[Z_PITCH] ** 2)
     eg = par[P_CHASSIS_MASS] * g * z[Z_Y]
     et = 0.0
     for i in range(nw):
         j = z_arm(i)
-        ke += (0.5 * par[P_ARM_MASS] * (zd[j + ZA_X] ** 2 + zd[j + ZA_Y] ** 2)
-               + 0.5 * par[P_ARM_INERTIA] * zd[j + ZA_BETA] ** 2)
-        eg += par[P_ARM_MASS] * g * z[j + ZA_Y]
-        et += 0.5 * kt * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0]) ** 2
+        ke += (0.5 * arms[i, ARMS_MASS] * (zd[j + ZA_X] ** 2 + zd[j + ZA_Y] ** 2)
+               + 0.5 * arms[i, ARMS_INERTIA] * zd[j + ZA_BETA] ** 2)
+        eg += arms[i, ARMS_MASS] * g * z[j + ZA_Y]
+        et += 0.5 * arms[i, ARMS_STIFFNESS] * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0]) ** 2
     mp = par[P_PIN_MASS]
     for k in range(nb, z.shape[0], 2):
         ke += 0.5 * mp * (zd[k] ** 2 + zd[k + 1] ** 2)

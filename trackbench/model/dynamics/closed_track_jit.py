@@ -55,9 +55,6 @@ from ..core.indices import (
     LP_TOOTH_DAMPING,
     LP_TOOTH_STIFFNESS,
     LP_TRAVEL,
-    P_ARM_INERTIA,
-    P_ARM_LENGTH,
-    P_ARM_MASS,
     P_C_WHEEL,
     P_CHASSIS_MASS,
     P_CONTACT_EXPONENT,
@@ -367,12 +364,11 @@ def closed_rhs(y, m, w, ydot, diag):
     a = (a[0] + da[0], a[1], a[2] + da[2], a[3] + da[3], a[4] + da[4], a[5] + da[5] + inertia)
     f = (f[0] + df[0], f[1] + df[1], f[2] + df[2])
     _forces_at_rest(f, w, nw, n, w.genf)
-    d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]
     a, f = take_out_rows(w.extra, 0.0, ARM_D, a, f)   # the sprocket's and the idler's rows
-    acc3 = chassis_acceleration(w.arm, d, a, f)
+    acc3 = chassis_acceleration(w.arm, a, f)
     acc = start_rates(ydot, qd, nq, acc3)
     for i in range(nw):
-        acc[Q_ARM + i] = row_acceleration(w.arm, i, d, acc3)
+        acc[Q_ARM + i] = row_acceleration(w.arm, i, w.arm[i, ARM_D], acc3)
     for r, k in ((LOOP_SPROCKET, i_spr), (LOOP_IDLER, i_idl)):
         acc[k] = row_acceleration(w.extra, r, w.extra[r, ARM_D], acc3)
     ke, e_grav = pin_accelerations(par, nw, n, w.apos, w.avel, w.fpin, acc, ke + ke_idler, e_grav + eg_idler)
@@ -401,7 +397,7 @@ def place_closed_samples(qs, m, pins, wheels, guides):
     """place_closed for every row of qs (output samples): pins (n, n_links, 2) (rows 1..n_links),
     wheels (n, n_wheels, 2), idler and rollers (n, n_guides, 2)."""
     apos = np.empty((pins.shape[1] + 1, 2))
-    arm = np.empty((m.arms.shape[0], ARM_COLS))
+    arm = np.empty((m.arms.shape[0], ARM_COLS + 1))
     for k in range(qs.shape[0]):
         place_closed(qs[k], m, apos, wheels[k], arm, guides[k])
         for b in range(pins.shape[1]):

@@ -18,7 +18,7 @@ from ..core.bundles import arm_table, model_arrays, work_arrays
 from ..core.indices_jit import n_coordinates, pin_offset, q_idler, q_sprocket
 from ..core.jit import KERNEL
 from ..ground.terrain import flat_ground
-from ..vehicle.parameters import equilibrium_arm_angle, pack, total_mass
+from ..vehicle.parameters import equilibrium_arm_angle, pack, station_columns, total_mass
 from .closed_track_jit import closed_rhs
 from .rhs import rhs
 
@@ -32,8 +32,8 @@ class StaticProblem:
             self.par[k] = v
         self.nw = int(vehicle["n_wheels"])
         self.n_links = int(track["n_links"])
-        self.phi = equilibrium_arm_angle(vehicle)
-        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
+        self.phi = equilibrium_arm_angle(vehicle)   # one per arm
+        self.arms = arm_table(piv, self.phi, 0.0, station_columns(vehicle, track))
         g = flat_ground()
         self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links,
                               rut=np.zeros(0) if soil else None)
@@ -97,6 +97,21 @@ def _loads_at_rest(q, m, w, diag):
 
 
 @njit(**KERNEL)
+def _arms_mass(arms):
+    """Every arm's mass: n m_a where they are all alike (the paper's sum, to the last bit)."""
+    nw = arms.shape[0]
+    alike = True
+    for i in range(1, nw):
+        alike = alike and arms[i, L.ARMS_MASS] == arms[0, L.ARMS_MASS]
+    if alike:
+        return nw * arms[0, L.ARMS_MASS]
+    total = 0.0
+    for i in range(nw):
+        total += arms[i, L.ARMS_MASS]
+    return total
+
+
+@njit(**KERNEL)
 def _residual(u, phi, m, w, diag, r, arm_moment):
     """Force balance of every free pin, vertical force and moment of chassis + arms
     (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
@@ -109,21 +124,20 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     q[L.Q_Y] = u[0]
     q[L.Q_PITCH] = u[1]
     for i in range(nw):
-        q[L.Q_ARM + i] = phi  # every arm at the same equilibrium angle
+        q[L.Q_ARM + i] = phi[i]  # every arm at its equilibrium angle
     for k in range(2, u.shape[0]):
         q[L.Q_ARM + nw + k - 2] = u[k]
     _loads_at_rest(q, m, w, diag)
     s, c = fm.sincos(u[1])
     g = par[L.P_GRAVITY]
-    ma = par[L.P_ARM_MASS]
     yc = u[0]
-    fy = fpin[0, 1] + fpin[n, 1] - (par[L.P_CHASSIS_MASS] + nw * ma) * g
+    fy = fpin[0, 1] + fpin[n, 1] - (par[L.P_CHASSIS_MASS] + _arms_mass(arms)) * g
     fx = fpin[0, 0] + fpin[n, 0]
     mom = 0.0
     for b in (0, n):
         mom += apos[b, 0] * fpin[b, 1] - (apos[b, 1] - yc) * fpin[b, 0]
     for i in range(nw):
-        wfy = fwheel[i, 1] - ma * g
+        wfy = fwheel[i, 1] - arms[i, L.ARMS_MASS] * g
         fy += fwheel[i, 1]
         fx += fwheel[i, 0]
         mom += wc[i, 0] * wfy - (wc[i, 1] - yc) * fwheel[i, 0]
@@ -155,7 +169,7 @@ class ClosedStaticProblem(StaticProblem):
         self.nw = int(vehicle["n_wheels"])
         self.n_links = geometry.n_links
         self.phi = equilibrium_arm_angle(vehicle)
-        self.arms = arm_table(piv, np.full(self.nw, self.phi), 0.0)
+        self.arms = arm_table(piv, self.phi, 0.0, station_columns(vehicle, track))
         g = flat_ground()
         self.m = model_arrays(
             self.par,
@@ -230,7 +244,7 @@ def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
     y[L.Q_Y] = u[0]
     y[L.Q_PITCH] = u[1]
     for i in range(nw):
-        y[L.Q_ARM + i] = phi
+        y[L.Q_ARM + i] = phi[i]
     y[q_idler(nw, n)] = u[2]
     y[q_sprocket(nw, n)] = u[3]
     off = pin_offset(nw)

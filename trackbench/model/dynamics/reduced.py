@@ -12,12 +12,17 @@ the order of a single loop.
 
 from numba import njit
 
-from ..core.bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COS, ARM_Q, ARM_SIN
+from ..core.bundles import ARM_BT, ARM_BX, ARM_BY, ARM_COS, ARM_D, ARM_Q, ARM_SIN
 from ..core.indices import (
     ARMS_DAMPING,
+    ARMS_DIAGONAL,
+    ARMS_INERTIA,
+    ARMS_LENGTH,
+    ARMS_MASS,
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    ARMS_STIFFNESS,
     D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
@@ -26,14 +31,10 @@ from ..core.indices import (
     D_E_KINETIC,
     D_E_TORSION,
     D_POWER,
-    P_ARM_INERTIA,
-    P_ARM_LENGTH,
-    P_ARM_MASS,
     P_CHASSIS_INERTIA,
     P_CHASSIS_MASS,
     P_GRAVITY,
     P_PIN_MASS,
-    P_TORSION_STIFFNESS,
     PN_LAST,
     PN_NQ,
     Q_ARM,
@@ -71,10 +72,6 @@ def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
     B_i of each arm and its generalised force (torsion bar included) into w.arm. Returns
     (A, f, (kinetic, torsion, gravity energies), power dissipated by the shock absorbers)."""
     mc = par[P_CHASSIS_MASS]
-    ma = par[P_ARM_MASS]
-    ia = par[P_ARM_INERTIA]
-    la = par[P_ARM_LENGTH]
-    kt = par[P_TORSION_STIFFNESS]
     g = par[P_GRAVITY]
     om = qd[Q_PITCH]
     a00 = mc
@@ -89,6 +86,10 @@ def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
     dissipation = 0.0
     e_grav = mc * g * q[Q_Y]
     for i in range(arms.shape[0]):
+        ma = arms[i, ARMS_MASS]
+        ia = arms[i, ARMS_INERTIA]
+        la = arms[i, ARMS_LENGTH]
+        kt = arms[i, ARMS_STIFFNESS]
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
         px, py = body_offset(c, s, arms[i, ARMS_PX], arms[i, ARMS_PY])
@@ -114,6 +115,7 @@ def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
         arm[i, ARM_BY] = ma * sy
         arm[i, ARM_BT] = ma * (rpx * sx + rpy * sy) + ia
         arm[i, ARM_Q] = sx * fx + sy * fy - kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0])
+        arm[i, ARM_D] = arms[i, ARMS_DIAGONAL]   # m l^2 + I: the arm block is diagonal
         if arms[i, ARMS_DAMPING] != 0.0:
             # rotary shock absorber: -c phi' on the arm, +c phi' on the chassis; phi is
             # relative to the chassis, so the pair acts on phi alone
@@ -151,10 +153,10 @@ def take_out_rows(rows, d, col_d, a, f):
 
 
 @njit(**INLINE)
-def chassis_acceleration(arm, d, a, f):
-    """(ax, ay, alpha) of the chassis: the Schur complement S = A - sum B_i B_i^T / d and
-    its right side, solved by cofactors (3x3 symmetric). d: the arms' diagonal mass."""
-    (s00, s01, s02, s11, s12, s22), (r0, r1, r2) = take_out_rows(arm, d, -1, a, f)
+def chassis_acceleration(arm, a, f):
+    """(ax, ay, alpha) of the chassis: the Schur complement S = A - sum B_i B_i^T / d_i and
+    its right side, solved by cofactors (3x3 symmetric). d_i: arm i's diagonal mass (ARM_D)."""
+    (s00, s01, s02, s11, s12, s22), (r0, r1, r2) = take_out_rows(arm, 0.0, ARM_D, a, f)
     c00 = s11 * s22 - s12 * s12
     c01 = s02 * s12 - s01 * s22
     c02 = s01 * s12 - s02 * s11
@@ -223,11 +225,10 @@ def reduced_rhs(y, m, w, ydot, diag):
         bristle_rates(ydot, nq, m.pins[PN_LAST], par, w.grip, diag)
     a, f, e, arm_dissipation = chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s,
                                                 _track_ends(q, par, apos, fpin))
-    d = par[P_ARM_MASS] * par[P_ARM_LENGTH] * par[P_ARM_LENGTH] + par[P_ARM_INERTIA]  # arm block: diagonal
-    acc3 = chassis_acceleration(arm, d, a, f)
+    acc3 = chassis_acceleration(arm, a, f)
     acc = start_rates(ydot, qd, nq, acc3)
     for i in range(arm.shape[0]):
-        acc[Q_ARM + i] = row_acceleration(arm, i, d, acc3)
+        acc[Q_ARM + i] = row_acceleration(arm, i, arm[i, ARM_D], acc3)
     ke, e_tors, e_grav = e
     ke, e_grav = pin_accelerations(par, arms.shape[0], apos.shape[0] - 2, apos, avel, fpin, acc, ke, e_grav)
     diag[D_DISSIPATION] += arm_dissipation

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core import indices as L
-from .parameters import wheel_centres_body
+from .parameters import per_wheel, wheel_centres_body
 from .teeth import pitch_radius as _pitch_radius
 from .track_path import closed_loop, closed_track, link_count
 
@@ -76,7 +76,7 @@ def _circles(v, tr, idl, rol, sprocket, rp, idler_at):
     def wrap(r):
         return fm.hypot(r + hw, 0.5 * tr["link_length"])
 
-    c = [(x, y, wrap(v["wheel_radius"])) for x, y in wheel_centres_body(v)]
+    c = [(x, y, wrap(r)) for (x, y), r in zip(wheel_centres_body(v), per_wheel(v, "wheel_radius"))]
     c.append((sprocket[0], sprocket[1], rp))
     c.append((idler_at[0], idler_at[1], wrap(idl["radius"])))
     c += [(x, y, wrap(rol["radius"])) for x, y in rol["positions"]]

@@ -8,7 +8,7 @@ from numba import njit
 
 from ..core import fixed_math as fm
 from ..core.bundles import ARM_COLS, ARM_COS, ARM_SIN
-from ..core.indices import ARMS_PX, ARMS_PY, P_ARM_LENGTH, Q_ARM, Q_PITCH, Q_X, Q_Y
+from ..core.indices import ARMS_LENGTH, ARMS_PX, ARMS_PY, Q_ARM, Q_PITCH, Q_X, Q_Y
 from ..core.indices_jit import q_pin
 from ..core.jit import INLINE, KERNEL
 
@@ -41,8 +41,8 @@ def place_wheels(q, par, arms, wc, arm):
     """Road-wheel centres of configuration q into wc; cos and sin of each arm's absolute
     angle into arm (Work.arm columns). Returns (cos, sin) of the pitch."""
     s, c = fm.sincos(q[Q_PITCH])
-    la = par[P_ARM_LENGTH]
     for i in range(arms.shape[0]):
+        la = arms[i, ARMS_LENGTH]
         beta = q[Q_PITCH] + q[Q_ARM + i]
         sb, cb = fm.sincos(beta)
         arm[i, ARM_COS] = cb
@@ -57,8 +57,8 @@ def place_wheels(q, par, arms, wc, arm):
 def wheel_velocities(qd, par, arms, wv, arm, c, s):
     """Road-wheel centre velocities (after place_wheels)."""
     om = qd[Q_PITCH]
-    la = par[P_ARM_LENGTH]
     for i in range(arms.shape[0]):
+        la = arms[i, ARMS_LENGTH]
         cb = arm[i, ARM_COS]
         sb = arm[i, ARM_SIN]
         rx, ry = wheel_offset(c, s, arms, i, la, cb, sb)
@@ -101,6 +101,6 @@ def positions(q, qd, par, arms, ends, apos, avel, wc, wv, arm):
 @njit(**KERNEL)
 def place_samples(qs, par, arms, ends, pins, wheels):
     """place() for every row of qs (output samples): pins (n, n_pins, 2), wheels (n, n_wheels, 2)."""
-    arm = np.empty((arms.shape[0], ARM_COLS))
+    arm = np.empty((arms.shape[0], ARM_COLS + 1))
     for k in range(qs.shape[0]):
         place(qs[k], par, arms, ends, pins[k], wheels[k], arm)

@@ -129,16 +129,37 @@ GRAVITY = 9.81
 NEIGHBOUR_SKIN = 0.05  # m; only sets how often the contact lists are rebuilt
 
 
+# the vehicle's values that may differ from road wheel to road wheel: a list (one per wheel,
+# front to rear; pivot_spacing one per gap between neighbours) or one number for every wheel
+PER_WHEEL = ("arm_mass", "arm_inertia", "arm_length", "arm_angle", "torsion_stiffness", "wheel_radius",
+             "pivot_y", "pivot_spacing")
+
+
+def per_wheel(vehicle, key):
+    """vehicle[key] as one float per road wheel, front to rear (pivot_spacing: one per gap)."""
+    n = int(vehicle["n_wheels"]) - (key == "pivot_spacing")
+    value = vehicle[key]
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return np.array(value, dtype=float)
+    return np.full(n, float(value))
+
+
 def pivots(vehicle):
-    """Body points of the arm pivots, wheel 1 (front) first: shape (n_wheels, 2)."""
+    """Body points of the arm pivots, wheel 1 (front) first: shape (n_wheels, 2). Pivot i
+    lies pivot_spacing behind pivot i - 1 (one spacing, or each gap its own)."""
     i = np.arange(int(vehicle["n_wheels"]))
-    return np.column_stack([vehicle["first_pivot_x"] - vehicle["pivot_spacing"] * i,
-                            np.full(i.size, vehicle["pivot_y"])])
+    spacing = vehicle["pivot_spacing"]
+    if isinstance(spacing, (list, tuple, np.ndarray)):
+        x = vehicle["first_pivot_x"] - np.concatenate([[0.0], np.cumsum(np.array(spacing, dtype=float))])
+    else:
+        x = vehicle["first_pivot_x"] - spacing * i
+    return np.column_stack([x, per_wheel(vehicle, "pivot_y")])
 
 
 def equilibrium_arm_angle(vehicle):
-    """phi at the initial equilibrium: trailing arm, arm_angle below the chassis x axis."""
-    return -math.pi + math.radians(vehicle["arm_angle"])
+    """phi of each arm at the initial equilibrium (one per wheel): trailing arm, arm_angle
+    below the chassis x axis."""
+    return np.array([-math.pi + math.radians(a) for a in per_wheel(vehicle, "arm_angle")])
 
 
 def wheel_centres_body(vehicle):
@@ -146,8 +167,23 @@ def wheel_centres_body(vehicle):
     the closed track's geometry and the equilibrium's start."""
     from ..core import fixed_math as fm  # numba: loaded when first needed
 
+    return wheel_centres_with(vehicle, fm.cos, fm.sin)
+
+
+def wheel_centres_with(vehicle, cos, sin):
+    """wheel_centres_body with the given cos and sin (a check's may use the C library's)."""
+    la = per_wheel(vehicle, "arm_length")
     phi = equilibrium_arm_angle(vehicle)
-    return pivots(vehicle) + vehicle["arm_length"] * np.array([fm.cos(phi), fm.sin(phi)])
+    return pivots(vehicle) + np.array([[la[i] * cos(p), la[i] * sin(p)] for i, p in enumerate(phi)])
+
+
+def station_columns(vehicle, track):
+    """{ARMS_* column: one value per road wheel}: what the kernels read per station."""
+    ma, ia, la = (per_wheel(vehicle, k) for k in ("arm_mass", "arm_inertia", "arm_length"))
+    r = per_wheel(vehicle, "wheel_radius")
+    return {L.ARMS_LENGTH: la, L.ARMS_REACH: r + track["pad_wheel"], L.ARMS_MASS: ma, L.ARMS_INERTIA: ia,
+            L.ARMS_STIFFNESS: per_wheel(vehicle, "torsion_stiffness"), L.ARMS_DIAGONAL: ma * la * la + ia,
+            L.ARMS_RADIUS: r}
 
 
 def _pack_contact(par, contact):
@@ -179,11 +215,10 @@ def pack(vehicle, track, gravity, contact=None):
     par = np.zeros(L.N_PAR)
     par[L.P_CHASSIS_MASS] = vehicle["chassis_mass"]
     par[L.P_CHASSIS_INERTIA] = vehicle["chassis_inertia"]
-    par[L.P_ARM_MASS] = vehicle["arm_mass"]
-    par[L.P_ARM_INERTIA] = vehicle["arm_inertia"]
-    par[L.P_ARM_LENGTH] = vehicle["arm_length"]
-    par[L.P_TORSION_STIFFNESS] = vehicle["torsion_stiffness"]
-    par[L.P_WHEEL_RADIUS] = vehicle["wheel_radius"]
+    for k, key in ((L.P_ARM_MASS, "arm_mass"), (L.P_ARM_INERTIA, "arm_inertia"),
+                   (L.P_ARM_LENGTH, "arm_length"), (L.P_TORSION_STIFFNESS, "torsion_stiffness"),
+                   (L.P_WHEEL_RADIUS, "wheel_radius")):
+        par[k] = per_wheel(vehicle, key)[0]   # wheel 1's; each station's own: station_columns
     par[L.P_PIN_MASS] = track["pin_mass"]
     par[L.P_LINK_LENGTH] = track["link_length"]
     par[L.P_LINK_STIFFNESS] = track["link_stiffness"]
@@ -200,8 +235,9 @@ def pack(vehicle, track, gravity, contact=None):
 
 
 def total_mass(vehicle, track):
-    return (vehicle["chassis_mass"] + vehicle["n_wheels"] * vehicle["arm_mass"]
-            + (track["n_links"] - 1) * track["pin_mass"])
+    arms = vehicle["arm_mass"]
+    arms = float(np.sum(arms)) if isinstance(arms, (list, tuple)) else vehicle["n_wheels"] * arms
+    return vehicle["chassis_mass"] + arms + (track["n_links"] - 1) * track["pin_mass"]
 
 
 def arm_damping(vehicle):

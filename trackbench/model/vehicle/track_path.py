@@ -27,10 +27,12 @@ def _lower_hull(points):
 
 def initial_track(ends_world, wheel_centres, rho, n_links):
     """Pins spread evenly along the taut path: the lower convex hull of the track ends
-    and the wheel circles of radius rho (wheel radius + pad). Pin 0 is the front end."""
+    and the wheel circles of radius rho (wheel radius + pad: one, or one per wheel). Pin 0 is
+    the front end."""
     from ..core import fixed_math as fm  # numba: loaded when first needed
     ang = np.linspace(0.0, 2 * np.pi, 361)[:-1]
-    circ = [c + rho * np.column_stack([fm.vcos(ang), fm.vsin(ang)]) for c in wheel_centres]
+    rhos = np.broadcast_to(rho, (len(wheel_centres),))
+    circ = [c + r * np.column_stack([fm.vcos(ang), fm.vsin(ang)]) for c, r in zip(wheel_centres, rhos)]
     hull = _lower_hull(np.vstack([ends_world] + circ))
     hull = hull[::-1]  # front (largest x) to rear
     seg = fm.vhypot(*np.diff(hull, axis=0).T)

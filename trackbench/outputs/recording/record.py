@@ -153,7 +153,7 @@ def _log_closed_static(rec, ds):
 
 
 def _log_static(rec, ds):
-    styles = _static_styles(int(ds.sizes["wheel"]), float(ds.attrs["wheel_radius"]))
+    styles = _static_styles(tuple(float(r) for r in G.wheel_radii(ds)))
     rec.log(E_GROUND, rr.LineStrips2D([_flip(G.ground_polyline(ds))], colors=[GROUND_RGB], radii=[0.015],
                                       labels=["ground"]), static=True)
     for e in (E_CHASSIS, E_ARMS, E_WHEELS, E_LINKS, E_PINS, E_WHEEL_FORCE, E_GROUND_FORCE,
@@ -278,7 +278,7 @@ def _log_frames(rec, ds, idx, follow=False):
     fx, fy = take("wheel_force_x"), take("wheel_force_y")
     gfx, gfy = take("ground_force_x"), take("ground_force_y")
     nw = wx.shape[1]
-    reach = float(ds.attrs["wheel_radius"]) + float(ds.attrs["pad_wheel"])
+    reach = G.wheel_radii(ds) + float(ds.attrs["pad_wheel"])   # per wheel: broadcasts over samples
     poly, hg = G.ground_polyline(ds), float(ds.attrs["pad_ground"])
     chassis = np.empty((n, len(bx), 2), dtype=np.float32)
     arms = np.empty((n, nw, 2, 2), dtype=np.float32)

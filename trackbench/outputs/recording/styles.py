@@ -39,14 +39,15 @@ from trackbench.outputs.recording.entities import (
 
 
 @functools.lru_cache(maxsize=16)
-def _static_styles(nw, r):
-    """The static archetypes that depend only on the wheel count and radius (built once per
+def _static_styles(radii):
+    """The static archetypes that depend only on the wheels' radii (one per wheel; built once per
     process: rerun's archetype constructors are slow next to logging them): entity -> archetype."""
+    nw = len(radii)
     return {
         E_CHASSIS: rr.LineStrips2D.from_fields(colors=[CHASSIS_RGB], radii=[0.02]),
         E_ARMS: rr.LineStrips2D.from_fields(colors=[ARM_RGB], radii=[0.03]),
         E_WHEELS: rr.Ellipses2D.from_fields(
-            half_sizes=[[r, r]] * nw,
+            half_sizes=[[r, r] for r in radii],
             colors=[wheel_rgb(i) for i in range(nw)],
             line_radii=[0.012],
             labels=[f"wheel {i + 1}" for i in range(nw)],

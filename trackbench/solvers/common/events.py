@@ -32,6 +32,8 @@ from ...model.contact.laws_jit import ramps_in
 from ...model.core import fixed_math as fm
 from ...model.core.bundles import ClosedEventWork
 from ...model.core.indices import (
+    ARMS_LENGTH,
+    ARMS_REACH,
     G_REACH,
     K_CORNER_LINK,
     K_CORNER_PIN,
@@ -46,14 +48,11 @@ from ...model.core.indices import (
     LP_TOOTH_DAMPING,
     N_KINDS,
     NB_COUNT,
-    P_ARM_LENGTH,
     P_CONTACT_DAMPING,
     P_CONTACT_GEOMETRY,
     P_DAMPING_RAMP,
     P_PAD_GROUND,
-    P_PAD_WHEEL,
     P_SOIL,
-    P_WHEEL_RADIUS,
     PN_NQ,
     Q_ARM,
     Q_PITCH,
@@ -196,7 +195,7 @@ def _teeth_gap_at_impl(b, t, step, nq, m, n_links, ev):
 def _wheel_at(i, w, step, nq, m):
     th = coordinate(w, step, Q_PITCH, nq)
     beta = th + coordinate(w, step, Q_ARM + i, nq)
-    rx, ry = wheel_offset(fm.cos(th), fm.sin(th), m.arms, i, m.par[P_ARM_LENGTH], fm.cos(beta),
+    rx, ry = wheel_offset(fm.cos(th), fm.sin(th), m.arms, i, m.arms[i, ARMS_LENGTH], fm.cos(beta),
                           fm.sin(beta))
     return coordinate(w, step, Q_X, nq) + rx, coordinate(w, step, Q_Y, nq) + ry
 
@@ -215,7 +214,7 @@ def _on_pin(kind):
 @njit(**INLINE)
 def _reach(kind, i, m):
     if kind == K_WHEEL_LINK or kind == K_WHEEL_PIN:
-        return m.par[P_WHEEL_RADIUS] + m.par[P_PAD_WHEEL]
+        return m.arms[i, ARMS_REACH]   # wheel radius + pad h_w, the station's own
     if kind == K_GUIDE_LINK or kind == K_GUIDE_PIN:
         return m.guides[i, G_REACH]
     return m.par[P_PAD_GROUND]

@@ -60,7 +60,7 @@ def _balance(P, u, it, first_pin=0):
     r, fx, arm_moment = P.residual(u)
     q = P.q_of(u)
     preload = -arm_moment
-    phi0 = q[L.Q_ARM : L.Q_ARM + P.nw] + preload / P.par[L.P_TORSION_STIFFNESS]
+    phi0 = q[L.Q_ARM : L.Q_ARM + P.nw] + preload / P.arms[:, L.ARMS_STIFFNESS]
     apos, fpin, fwheel, wc = P.loads(q)
     tension = P.diag[L.diag_tension(P.nw) : L.diag_tension(P.nw) + P.n_links].copy()
     return Equilibrium(
@@ -82,11 +82,12 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     (soil: {P_* index: value} of soft soil, run/assemble.soil_par). A power law is reached by
     continuation (continuation.py)."""
     P = StaticProblem(vehicle, track, gravity, contact, soil)
-    rho = P.par[L.P_WHEEL_RADIUS] + P.par[L.P_PAD_WHEEL]
+    rho = P.arms[:, L.ARMS_REACH]   # each wheel's radius + pad
     hg = P.par[L.P_PAD_GROUND]
-    # start: wheels resting on the track, the track on the ground, chassis level
+    # start: wheels resting on the track, the track on the ground, chassis level (the
+    # lowest wheel's bottom; rounding is monotonic: max(-y + rho) is -min(y) + rho alike)
     wcb = wheel_centres_body(vehicle)
-    yc = -wcb[:, 1].min() + rho + hg
+    yc = float(np.max(-wcb[:, 1] + rho)) + hg
     ends_w = P.ends + [0.0, yc]
     pins, _, _ = initial_track(ends_w, wcb + [0.0, yc], rho, P.n_links)
     u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])

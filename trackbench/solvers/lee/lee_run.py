@@ -182,7 +182,7 @@ def run(model, y0, controls):
     ls = LeeSettings(int(own["accel_order"]), int(own["eps_iterations"]), float(own["position_tol"]),
                      int(own["max_iterations"]), float(own["matrix_update_angle"]))
     lw = lee_arrays(model.nw, model.n_links, tab.c.shape[0], L.n_diag(model.nw, model.n_links), y0.size)
-    minv = inverse_mass(model.par, model.nw, model.n_links)
+    minv = inverse_mass(model.par, model.arms, model.n_links)
     integrate_lee(y0, controls.loop_control, tab, ls, minv, model.arrays, model.work,
                   event_arrays(model.nw, model.n_links), lw, out, lout)
     n = int(out.stats[L.S_N_OUT])

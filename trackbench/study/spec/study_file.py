@@ -227,7 +227,7 @@ def load_study(path, output=None):
         raise StudyError(f"{path}: [scenario] must be a table")
     base_doc = _files_beside(base_doc, path)
     try:
-        base = Scenario.from_dict(base_doc)
+        base = Scenario.from_dict(base_doc, folder=str(path.parent))   # vehicle files beside the study
     except ScenarioError as e:
         raise StudyError(f"{path}: [scenario]: {e}") from None
     variants, axes, zips, explicit = _variants(doc, path)
