@@ -88,7 +88,9 @@ class ForkServerPools:
         return _context().get_start_method()
 
     def close(self):
-        forget()
+        """The study is done: the server goes before the command does, so that nothing of the
+        command outlives it (left alone, the server notices the command's end a moment after)."""
+        stop_server()
 
 
 def _server_pid():
@@ -112,7 +114,20 @@ def stop_server():
             forkserver._forkserver._stop()
         except (ProcessLookupError, ChildProcessError):
             pass
+    _stop_resource_tracker()
     forget()
+
+
+def _stop_resource_tracker():
+    """multiprocessing's resource tracker (started by the pool's locks) stopped and waited for,
+    as its own tests do, instead of leaving it to notice the command's end."""
+    from multiprocessing import resource_tracker
+    stop = getattr(resource_tracker._resource_tracker, "_stop", None)
+    if stop is not None:
+        try:
+            stop()
+        except (OSError, ChildProcessError):
+            pass
 
 
 @contextmanager
