@@ -385,3 +385,29 @@ def test_the_search_line_labels_the_bar_on_a_terminal_and_is_a_line_of_a_log():
     p.close()
     assert log.getvalue().splitlines() == ["search: round 1", "10 runs to do, 0 already completed",
                                            "search: round 2", "2 runs to do, 1 already completed"]
+
+
+def test_a_search_over_seeds_reads_as_the_median_of_the_seeds_limits(tmp_path):
+    """Each seed's limit is a row of limits.csv; over_seeds gives per roughness the median of
+    those found, their range and how many of the seeds found one; the limit curve draws it."""
+    import pandas as pd
+
+    from trackbench.study.read.limits import over_seeds
+    limits = pd.DataFrame({
+        "terrain.rms_in": [0.5, 0.5, 0.5, 1.0, 1.0, 1.0], "terrain.seed": [1, 2, 3, 1, 2, 3],
+        "search_value": [12.0, 14.0, 13.5, 8.0, float("nan"), 9.0],
+        "status": ["found", "found", "found", "found", "limit_exceeded_at_low", "found"],
+        "runs": [5] * 6, "limit_run": ["a"] * 6})
+    m = over_seeds(limits)
+    assert m["median"].tolist() == [13.5, 8.5] and m["min"].tolist() == [12.0, 8.0]
+    assert m["max"].tolist() == [14.0, 9.0] and m["found"].tolist() == [3, 2] and m["seeds"].tolist() == [3, 3]
+    pytest.importorskip("matplotlib")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from trackbench.figures.limit_figures import _limit_curve
+    search = {"parameter": "speed", "quantity": "absorbed_power", "limit": 6.0, "tolerance": 1.0,
+              "low": 2.0, "high": 16.0}
+    path = _limit_curve(limits, ["terrain.rms_in", "terrain.seed"], search, tmp_path, plt)
+    assert path.is_file() and path.stat().st_size > 10_000

@@ -68,11 +68,22 @@ def _limit_curve(limits, axes, search, out, plt):
     for status, (marker, text) in _STATUS_MARK.items():
         if (limits["status"] == status).any():
             ax.scatter([], [], marker=marker, color="grey", label=text)
+    if x_name and len(axes) == 2 and axes[1].endswith("seed"):
+        _median_over_seeds(ax, limits, x_name, axes[1])
     ax.set_xlabel(axis_label(x_name, limits[x_name]) if x_name else "grid point")
     ax.set_ylabel(f"highest {axis_label(name)}")
     ax.set_title(f"{name} limit: {quantity} <= {search['limit']:g} (to {search['tolerance']:g})",
                  fontsize=10)
     return _saved(fig, ax, Path(out) / f"limit_{name.replace('.', '_')}.png", plt, 8)
+
+
+def _median_over_seeds(ax, limits, x_name, seed):
+    """The seeds' median limit as a thick line, their range shaded (study/read/limits.over_seeds)."""
+    from trackbench.study.read.limits import over_seeds
+    m = over_seeds(limits, seed).dropna(subset=["median"]).sort_values(x_name)
+    xs = m[x_name].to_numpy(float)
+    ax.fill_between(xs, m["min"], m["max"], color="black", alpha=0.12, label="the seeds' range")
+    ax.plot(xs, m["median"], color="black", lw=2.5, label="median over the seeds")
 
 
 def _quantity_figure(summary, limits, axes, search, out, plt):

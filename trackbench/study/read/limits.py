@@ -95,3 +95,16 @@ def write_limits(study):
     with store.atomic_path(Path(study.output) / LIMITS_FILE) as tmp:
         df.to_csv(tmp, index=False)
     return df, S.state_line(study.search, searches)
+
+
+def over_seeds(limits, seed="terrain.seed"):
+    """A search over several seeds of a random ground, one limit per grid point but the seed:
+    the median of the seeds' limits with their min and max and how many were found (a pandas
+    DataFrame; a point whose limit was not found counts out of the median, its status counted
+    in ``found``). The seeds' own limits stay in limits.csv."""
+    axes = [c for c in limits.columns if c not in (seed, *LIMIT_COLUMNS)]
+    found = limits[limits["status"].isin(["found", "non_monotone"])]
+    by = (found.groupby(axes, sort=True) if axes else found.groupby(lambda _: 0))["search_value"]
+    out = by.agg(median="median", min="min", max="max", found="count").reset_index()
+    seeds = limits.groupby(axes, sort=True)[seed].count().reset_index(name="seeds") if axes else None
+    return out.merge(seeds, on=axes, how="right") if axes else out.assign(seeds=len(limits))
