@@ -18,7 +18,7 @@ from trackbench.study import StudyError, load_study, store
 from trackbench.study.execute.runner import check_output, manifest
 from trackbench.study.spec.study_file import resolved_toml
 
-CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
 FAST = "duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 

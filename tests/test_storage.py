@@ -98,7 +98,7 @@ def test_bad_storage_names_the_value_and_what_is_allowed(tmp_path):
         [
             sys.executable,
             "-c",
-            "from trackbench.cli.app import main; main()",
+            "from trackbench.cli import main; main()",
             "run",
             "--storage",
             "x",
@@ -143,7 +143,7 @@ def test_run_command_with_compact_storage(tmp_path):
         [
             sys.executable,
             "-c",
-            "from trackbench.cli.app import main; main()",
+            "from trackbench.cli import main; main()",
             "run",
             "--storage",
             "compact",

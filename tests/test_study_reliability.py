@@ -26,7 +26,7 @@ from trackbench.study.execute import executors
 from trackbench.study.execute.runner import confirm
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
 FAST = "duration = 0.02\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 ENV = {**os.environ, "PYTHONPATH": str(REPO), "NUMBA_CACHE_DIR": os.environ.get("NUMBA_CACHE_DIR", "")}
 if not ENV["NUMBA_CACHE_DIR"]:
@@ -489,7 +489,7 @@ def test_real_full_disk_then_rerun_with_space(tmp_path):
     p = write_study(tmp_path, "full", speeds=(5.0, 6.0, 7.0, 8.0), scenario=scen)
     out, keep = tmp_path / "results" / "full", tmp_path / "kept"
     out.mkdir(parents=True)
-    run = f"{sys.executable} -c 'from trackbench.cli.app import main; main()' study run {p} --workers 2"
+    run = f"{sys.executable} -c 'from trackbench.cli import main; main()' study run {p} --workers 2"
     script = (
         f"mount -t tmpfs -o size=800k tmpfs {out} || exit 99; "
         f"{run} > {tmp_path}/1.out 2> {tmp_path}/1.err; echo $? > {tmp_path}/1.rc; "

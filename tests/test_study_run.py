@@ -19,7 +19,7 @@ from trackbench.study import StudyLocked, load_study, run_study, store
 from trackbench.study.read.summary import write_summary
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
 FAST = "duration = 0.05\noutput_interval = 0.001\nrecord = { enabled = false }\n"
 
 

@@ -10,7 +10,7 @@ import pytest
 from trackbench.study.spec.study_file import StudyError, load_study, resolved_toml
 
 REPO = Path(__file__).resolve().parents[1]
-CLI = [sys.executable, "-c", "from trackbench.cli.app import main; main()"]
+CLI = [sys.executable, "-c", "from trackbench.cli import main; main()"]
 
 
 def study(tmp_path, text, name="s.toml"):
