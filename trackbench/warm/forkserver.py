@@ -16,7 +16,7 @@ from trackbench.warm.protocol import (
     spec,
     warm_kinds,
 )
-from trackbench.warm.startup import single_threaded_libraries
+from trackbench.warm.startup import die_with_parent, single_threaded_libraries
 
 PRELOAD = "trackbench.warm.preload"
 
@@ -54,10 +54,17 @@ def start_workers(executor="local", scheduler=None, warm=None):
         forkserver.ensure_running()
 
 
+def _forked_worker():
+    """Pool initializer of the fork server's workers: each ends with the server."""
+    die_with_parent()
+
+
 def _warm_spawned():
-    """Pool initializer of spawned workers (no fork server): the fork server's preload, run
-    in the worker itself (importing preload.py warms the process), and rerun's set-up, which
-    the fork server leaves out. Warming is an optimisation only: a real run reports errors."""
+    """Pool initializer of spawned workers (no fork server): they end with the command; the
+    fork server's preload, run in the worker itself (importing preload.py warms the process),
+    and rerun's set-up, which the fork server leaves out. Warming is an optimisation only: a
+    real run reports errors."""
+    die_with_parent()
     try:
         from trackbench.warm import preload
         preload.warm_recording()
@@ -79,8 +86,8 @@ class ForkServerPools:
         from concurrent.futures import ProcessPoolExecutor
         start_workers()
         ctx = _context()
-        warm = _warm_spawned if ctx.get_start_method() == "spawn" else None
-        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=warm)
+        start = _warm_spawned if ctx.get_start_method() == "spawn" else _forked_worker
+        return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=start)
 
     def dask_context(self):
         """How a LocalCluster's nannies start their workers: from the same server."""

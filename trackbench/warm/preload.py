@@ -25,8 +25,9 @@ never forked.
 
 import os
 
-from trackbench.warm.startup import threads
+from trackbench.warm.startup import die_with_parent, threads
 
+die_with_parent()       # the server ends with the command, even a command that is killed
 THREADS_AT_FORK = None
 PARENT = os.getppid()   # the command that started the server
 

@@ -34,3 +34,18 @@ def threads():
         return len(os.listdir("/proc/self/task"))
     except OSError:
         return None
+
+
+def die_with_parent():
+    """This process is killed (SIGKILL) when its parent ends, however it ends (Linux; elsewhere
+    nothing): the fork server with the command, a worker with the fork server, so that a command
+    killed from a script leaves nothing running. A parent already gone: leave now."""
+    import ctypes
+    import signal
+    parent = os.getppid()
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent:
+        os._exit(1)
