@@ -107,6 +107,9 @@ class Controls:
     n_samples: int    # the output grid's samples, t = 0 and the last included
     method: str       # the method the solver runs (its entry's method, or its label)
     settings: dict = field(default_factory=dict)   # the solver's own table (registry: settings)
+    # the pins' velocities' own tolerance in the error norm (the scenario's tolerance_pin_velocity;
+    # 0: not set, the method's default); the methods that read it say so in their registry entry
+    tolerance_pin_velocity: float = 0.0
 
     @property
     def loop_control(self):
@@ -115,7 +118,8 @@ class Controls:
                        self.max_steps, self.n_samples)
 
 
-def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, method="", settings=None):
+def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, method="", settings=None,
+             tolerance_pin_velocity=0.0):
     """The Controls of a run from its settings. The step is the error control's alone,
     whatever the output interval (samples come from the dense output), up to ``max_step``
     where one is set (0: none)."""
@@ -123,7 +127,8 @@ def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, me
     dt_out = float(output_interval)
     h_max = min(float(max_step) or t_end, (CHUNK_ROWS - 1) * dt_out)
     return Controls(t_end, dt_out, float(tolerance), float(tolerance), min(H0, h_max), h_max, H_MIN,
-                    step_cap(max_steps, t_end), n_samples(t_end, dt_out), method, dict(settings or {}))
+                    step_cap(max_steps, t_end), n_samples(t_end, dt_out), method, dict(settings or {}),
+                    float(tolerance_pin_velocity or 0.0))
 
 
 STEPS_PER_SECOND = 400_000   # max_steps = 0: the closed track with friction takes ~160,000 a second
