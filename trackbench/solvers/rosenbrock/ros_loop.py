@@ -17,7 +17,8 @@ older than one step is renewed after J_REJECTIONS rejections in a row). The erro
 the pins' velocities to their own tolerance (stepping.error_norm_pins). Everything around the
 step (peaks, event location, the memories) is the explicit pairs' (solvers/common/stepping.py),
 and so are the samples' positions (the quintic Hermite interpolant); their velocities are the
-cubic Hermite of (qd, qdd), of order 3 as the method (stepping.dense_state). Scratch: ``lw`` (RosWork), ``jw`` (JacobianWork)."""
+cubic Hermite of (qd, qdd), of order 3 as the method (stepping.dense_state). Scratch: ``lw``
+(RosWork), ``jw`` (JacobianWork)."""
 
 from collections import namedtuple
 
@@ -38,7 +39,7 @@ from ..common.control import (
     finish_stats,
 )
 from ..common.events import first_contact_switch
-from ..common.pin_jacobian import J_REJECTIONS, factor, pin_jacobian, solve
+from ..common.pin_jacobian import J_REJECTIONS, factor_velocities, pin_jacobian, solve_velocities
 from ..common.stepping import accept_step, chunk_full, end_of_step, error_norm_pins, keep_state, loop_resume
 
 # The loop's settings beside base.Control: the pins' velocities in y (lo..hi-1) and their
@@ -55,7 +56,8 @@ RosWork = namedtuple("RosWork", [
     "z",      # (ny,) a stage's solution
     "er",     # (ny,) the error estimate
     "diag",   # (n_diag,) diagnostics of the last evaluation
-    "counts",  # (1,) Jacobians formed (kept across the chunks of a streamed run)
+    "counts",  # (4,) Jacobians formed; rejections at a located contact switch, by the error alone,
+               # at an onset (kept across the chunks of a streamed run)
     "end",    # stepping.EndOfStep: the ground's state at the end of the accepted step
 ])
 
@@ -66,7 +68,7 @@ RosWork.CUBIC_VELOCITIES = True
 
 def loop_arrays(stages, ny, n_diag, n_pins):
     return RosWork(np.zeros((2, ny)), np.zeros((stages, ny)), np.empty(ny), np.empty(ny), np.empty(ny),
-                   np.empty(ny), np.empty(ny), np.empty(ny), np.zeros(n_diag), np.zeros(1, dtype=np.int64),
+                   np.empty(ny), np.empty(ny), np.empty(ny), np.zeros(n_diag), np.zeros(4, dtype=np.int64),
                    end_of_step(n_pins))
 
 
@@ -94,7 +96,7 @@ def _stage(i, h, tab, nq, m, w, lw, jw):
             if c != 0.0:
                 for k in range(n):
                     fs[k] += c * U[j, k]
-    solve(h * tab.gamma, nq, jw, fs, lw.z)
+    solve_velocities(h * tab.gamma, nq, jw, fs, lw.z)
     for k in range(n):
         U[i, k] = lw.z[k]
     return used
@@ -108,7 +110,7 @@ def _step(h, tab, m, w, lw, jw):
     n = y.shape[0]
     nq = m.pins[PN_NQ]
     used = 0
-    factor(h * tab.gamma, jw)
+    factor_velocities(h * tab.gamma, jw)
     for i in range(tab.m.shape[0]):
         used += _stage(i, h, tab, nq, m, w, lw, jw)
     for k in range(n):
@@ -156,6 +158,7 @@ def integrate(y0, ctl, rc, tab, m, w, ev, lw, jw, out):
             if err == err and err > 0.0:
                 th = first_contact_switch(y, K[0], lw.y_new, K[1], h, m, ev)
             h, at_switch = after_rejection(h, err, tab.expo, th, ctl.h_min)
+            lw.counts[1 if at_switch else 2] += 1
             fac_max = 1.0
             if age > 0:
                 in_row += 1   # a stale Jacobian may be why
@@ -164,6 +167,7 @@ def integrate(y0, ctl, rc, tab, m, w, ev, lw, jw, out):
             th = first_contact_switch(y, K[0], lw.y_new, K[1], h, m, ev)
             if th < 1.0 and th * h > ctl.h_min:
                 rejected += 1
+                lw.counts[3] += 1
                 h *= th
                 at_switch = True
                 fac_max = 1.0

@@ -25,14 +25,15 @@ def pin_velocities(jw):
     return lo, hi
 
 
-def ros_control(controls, jw, jacobian_age=JACOBIAN_AGE):
-    """The loop's RosControl: the pins' velocities and their tolerance."""
+def ros_control(controls, jw, jacobian_age=None):
+    """The loop's RosControl: the pins' velocities and their tolerance, the accepted steps one
+    W serves (None: JACOBIAN_AGE, as this module holds it when the run starts)."""
     lo, hi = pin_velocities(jw)
     tol_v = controls.tolerance_pin_velocity or PIN_VELOCITY_RATIO * controls.rtol
-    return RosControl(lo, hi, float(tol_v), int(jacobian_age))
+    return RosControl(lo, hi, float(tol_v), int(jacobian_age or JACOBIAN_AGE))
 
 
-def run(model, y0, controls, sink=None, jacobian_age=JACOBIAN_AGE):
+def run(model, y0, controls, sink=None, jacobian_age=None):
     """The run of controls.method in one piece; with a sink (base.run_chunks), streamed to it
     in chunks. jacobian_age: the accepted steps one W serves (a measurement's knob)."""
     tab = ROS_TABLEAUS[controls.method].arrays()
@@ -48,5 +49,7 @@ def run(model, y0, controls, sink=None, jacobian_age=JACOBIAN_AGE):
         "jacobian_evaluations": ((), np.int64(lw.counts[0]), "1", "the pins' block Jacobians formed"),
         "tolerance_pin_velocity": ((), rc.tol_pin_velocity, "1",
                                    "the tolerance the error norm held the pins' velocities to"),
+        "rejected_at_switch": ((), np.int64(lw.counts[1] + lw.counts[3]), "1",
+                               "rejected steps retried to end just after a located contact switch"),
     }
     return trimmed(controls, out, extra)
