@@ -61,9 +61,14 @@ def _energy_line(ds, s):
     return f"  energy balance error              {err:.4f} % (paper: < 0.06 %){tail}"
 
 
-def _integrator(attrs):
-    """The solver, its method and tolerance, as the run's attributes name them."""
-    return f"{attrs['solver']} {attrs['method']} at tolerance {attrs['tolerance']:g}"
+def _integrator(ds):
+    """The solver, its method and tolerance, as the run's attributes name them; the pins'
+    velocities' own tolerance where the method held them to one."""
+    a = ds.attrs
+    text = f"{a['solver']} {a['method']} at tolerance {a['tolerance']:g}"
+    if "tolerance_pin_velocity" in ds:
+        text += f" (pins' velocities {float(ds.tolerance_pin_velocity):g})"
+    return text
 
 
 def format_summary(ds, path=None):
@@ -111,7 +116,7 @@ def format_summary(ds, path=None):
     ]
     lines += [
         _energy_line(ds, s),
-        f"  {_integrator(a)}: steps {a['steps']} (+{a['rejected_steps']} rejected), wall time "
+        f"  {_integrator(ds)}: steps {a['steps']} (+{a['rejected_steps']} rejected), wall time "
         f"{a['wall_time']:.3f} s",
     ]
     if shown(compression.name) == shown(compression.name):  # a link went into compression

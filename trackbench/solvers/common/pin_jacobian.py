@@ -234,18 +234,27 @@ def solve(hg, nq, jw, r, u):
 # A block of J is [[0, I, 0], [0, D]] over (x, y | vx, vy (| z)): its position columns are 0
 # (scale 0: not differenced) and its position rows the kinematic identity. So (I / (h gamma) -
 # J) u = r is (I / (h gamma) - D) u_v = r_v, then u_x = h gamma (r_x + u_v): an LU of the
-# (nb - 2)-square velocity part D, a quarter to a ninth of the whole block's work.
+# (nb - 2)-square velocity part D (a 2x2 one inverted outright), a fraction of the whole
+# block's work.
 
 
 @njit(**BORROW)
 def factor_velocities(hg, jw):
-    """LU factors (partial pivoting, a fixed order) of each block's velocity part I / (h gamma)
-    - D, in rows and columns N_KINEMATIC.. of jw.lu."""
+    """Each block's velocity part I / (h gamma) - D, in rows and columns N_KINEMATIC.. of jw.lu:
+    a 2x2 part (no bristles) as its inverse; a larger one as LU factors (partial pivoting, a
+    fixed order)."""
     lu, piv, nb = jw.lu, jw.piv, jw.blk.shape[1]
+    k = N_KINEMATIC
     for b in range(lu.shape[0]):
         for r in range(N_KINEMATIC, nb):
             for j in range(N_KINEMATIC, nb):
                 lu[b, r, j] = (1.0 / hg if r == j else 0.0) - jw.jac[b, r, j]
+        if nb == k + 2:
+            a, c, d, e = lu[b, k, k], lu[b, k, k + 1], lu[b, k + 1, k], lu[b, k + 1, k + 1]
+            det = a * e - c * d
+            lu[b, k, k], lu[b, k, k + 1] = e / det, -c / det
+            lu[b, k + 1, k], lu[b, k + 1, k + 1] = -d / det, a / det
+            continue
         for col in range(N_KINEMATIC, nb):
             p = col
             for r in range(col + 1, nb):
@@ -272,6 +281,15 @@ def solve_velocities(hg, nq, jw, r, u):
         u[nq + k] = hg * r[nq + k]
         u[k] = hg * (r[k] + u[nq + k])
     blk, rb, lu, piv, nb = jw.blk, jw.rb, jw.lu, jw.piv, jw.blk.shape[1]
+    k = N_KINEMATIC
+    if nb == k + 2:   # the inverses of factor_velocities
+        for b in range(blk.shape[0]):
+            ix, iy, ivx, ivy = blk[b, 0], blk[b, 1], blk[b, k], blk[b, k + 1]
+            vx = lu[b, k, k] * r[ivx] + lu[b, k, k + 1] * r[ivy]
+            vy = lu[b, k + 1, k] * r[ivx] + lu[b, k + 1, k + 1] * r[ivy]
+            u[ivx], u[ivy] = vx, vy
+            u[ix], u[iy] = hg * (r[ix] + vx), hg * (r[iy] + vy)
+        return
     for b in range(blk.shape[0]):
         for j in range(N_KINEMATIC, nb):
             rb[j] = r[blk[b, j]]
