@@ -55,3 +55,26 @@ def test_a_short_driven_run_is_judged_against_its_ensemble(short_ensemble):
     assert ok, failed
     ok, failed = accuracy.verdict(_peaks({"method": "ros34pw2", "tolerance": 1e-3}), short_ensemble)
     assert not ok and failed
+
+
+def test_trackbench_run_names_the_ill_conditioned_peaks():
+    """On the driven step run `trackbench run` names the peaks measured ill-conditioned for its
+    model (compare as ranges), the others as numbers; elsewhere, after a link compression, the
+    general note."""
+    import json
+
+    import xarray as xr
+
+    from trackbench.cli.single_run import _ranges_note
+
+    def note(over):
+        sc = tb.Scenario.from_dict({**CLOSED, "duration": 0.5, **over}).to_dict()
+        return " ".join(_ranges_note(xr.Dataset(attrs={"scenario": json.dumps(sc)}), 0.03))
+
+    regularised = note({})
+    assert "compare as ranges: peak vertical wheel-track force (wheel 5), 8.4 %" in regularised
+    assert "min chassis vertical acceleration, 4.5 %" in regularised
+    assert "wheel 5" in note({"contact.friction_law": "bristle"})
+    assert "acceleration" not in note({"contact.friction_law": "bristle"})
+    assert "min chassis vertical acceleration, 2.3 %" in note({"terrain.soil": "lete_sand"})
+    assert "after the first compression" in note({"speed": 5.0, "drive.target": 5.0})

@@ -11,9 +11,10 @@ entry says ``streams``, ``run(model, y0, controls, sink=None)``), where
   reduced state at t = 0 (q, qd, extras, bristle deflections: model/core/indices.py);
 - ``controls`` is a ``Controls``, built once per run by the run layer from the validated
   scenario (registry.SolverEntry.controls): t_end, the output interval, the tolerances, the
-  step limits (h0, h_max, h_min, max_steps), the number of samples, the method it runs, and
-  its own settings table (``controls.settings``: e.g. lee's ``accel_order``); the compiled
-  loops take its numeric part, ``controls.loop_control`` (a ``Control``).
+  step limits (h0, h_max, h_min, max_steps), the number of samples, the method it runs, its
+  own settings table (``controls.settings``: e.g. lee's ``accel_order``) and the pins'
+  velocities' own tolerance where the scenario sets one; the compiled loops take its numeric
+  part, ``controls.loop_control`` (a ``Control``).
 
 The solver:
 
@@ -24,7 +25,13 @@ The solver:
    (model/core/indices.py): every output means the same whichever solver made it;
 3. controls its step by an error estimate and never steps over a contact switch: an onset
    or release inside a rejected step is located (solvers/common/events.py) and the retry
-   ends just after it;
+   ends just after it. In the reduced solver the estimate's norm is an RMS over q, qd and the
+   bristles' deflections (never the extras: work quadratures, the drive's integral) of
+   e_k / (tol_k (1 + max(|y_k|, |y_new,k|))) (DOP853: Hairer's combination of its two
+   estimates), tol_k = ``controls.rtol`` (= atol, the scenario's tolerance) for every
+   component, except that a method whose registry entry says so (ros34pw2) holds the pins'
+   velocities to ``controls.tolerance_pin_velocity`` (0: the method's default;
+   solvers/common/stepping.py error_norm_pins);
 4. chooses its step by its error control alone (from ``h0``, up to ``h_max``), whatever the
    output interval, and fills ``Outputs`` (``allocate_outputs``): samples at t_k = k dt_out
    from its dense output between accepted steps, the peaks over every accepted step
@@ -109,6 +116,7 @@ class Controls:
     settings: dict = field(default_factory=dict)   # the solver's own table (registry: settings)
     # the pins' velocities' own tolerance in the error norm (the scenario's tolerance_pin_velocity;
     # 0: not set, the method's default); the methods that read it say so in their registry entry
+    # (contract point 3)
     tolerance_pin_velocity: float = 0.0
 
     @property

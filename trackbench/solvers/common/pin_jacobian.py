@@ -126,7 +126,9 @@ def _perturb(y, jw, pins, j):
 def pin_jacobian(y, f0, m, w, jw, diag):
     """The pins' blocks of J at (y, f0 = f(y)) by forward differences; returns the number of
     right-hand sides it took. Leaves w as evaluated at a perturbed state: call it before a
-    step's stages, never between the step's end and the memories' moves."""
+    step's stages, never between the step's end and the memories' moves. f0 must be f with the
+    memories as they are now: not the last step's f(y_new) once the soil's memory has moved
+    after it (each difference would carry the memory's jump over a 1e-9 perturbation)."""
     blk, jac, nb = jw.blk, jw.jac, jw.blk.shape[1]
     for b in range(blk.shape[0]):
         for r in range(N_KINEMATIC):

@@ -8,7 +8,8 @@ and no product with W:
 
 The first stage's f is f(y), the previous step's last evaluation; with f(y_new), needed by
 the dense output, the event location and the next step, a step takes s right-hand sides
-(ROS34PW2: 4), and a Jacobian colours x 2 more (x 3 with the bristle law's deflections).
+(ROS34PW2: 4), and a Jacobian colours x 2 more (x 3 with the bristle law's deflections) and
+f(y) afresh (the soil's memory moved since the last evaluation).
 
 A W-method keeps its order whatever W is (3 for ROS34PW2): W decides only where the step is
 stable, and a W from an earlier step serves while it holds the stiff terms close enough
@@ -146,7 +147,8 @@ def integrate(y0, ctl, rc, tab, m, w, ev, lw, jw, out):
             out.resume[RS_AGE], out.resume[RS_IN_ROW] = age, in_row
             return
         if age >= rc.jacobian_age or in_row >= J_REJECTIONS:
-            n_rhs += pin_jacobian(y, K[0], m, w, jw, lw.diag)
+            rhs(y, m, w, lw.fs, lw.diag)   # not K[0]: the memories moved since (pin_jacobian)
+            n_rhs += 1 + pin_jacobian(y, lw.fs, m, w, jw, lw.diag)
             lw.counts[0] += 1
             age = 0
             in_row = 0

@@ -16,7 +16,7 @@ from .ros_tableau import ROS_TABLEAUS
 PIN_VELOCITY_RATIO = 10.0
 # accepted steps one W (the pins' blocks) serves, renewed sooner after J_REJECTIONS rejections
 # in a row: measured on the closed, driven step run (1e-6, pins 1e-5), every 1 / 3 / 10 / 20
-# steps 6.0x / 4.7x / 4.0x / 4.1x the paper model's wall time, the peaks alike
+# steps 7.3x / 4.7-4.9x / 4.0x / 4.1x the paper model's wall time, the peaks alike
 JACOBIAN_AGE = 10
 
 
