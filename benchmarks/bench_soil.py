@@ -5,15 +5,16 @@ Also the work against precision of the closed step on LETE sand (benchmarks/work
 Prints figures; asserts nothing.
 
     python benchmarks/bench_soil.py           # everything
-    python benchmarks/bench_soil.py soils     # one part: cost, soils, slips, stiff_slips, precision, spread
+    python benchmarks/bench_soil.py soils     # one part: cost, ratios, soils, slips, stiff_slips, precision,
+                                              # spread, criterion
     python benchmarks/bench_soil.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
 """
 
 import sys
 
 import work_precision
-from bench_closed import STEP
-from side_by_side import best_walls
+from bench_closed import ROSENBROCK, STEP
+from side_by_side import against_the_paper, best_walls
 
 import trackbench as tb
 from trackbench.outputs.metrics.traction import pressure_effect, run_soil, steady, wong
@@ -30,6 +31,14 @@ def cost():
         f"cost: paper_step on LETE sand / rigid ground wall time {best['lete_sand'] / best['rigid']:.2f} "
         f"(best of {REPEATS}; target: at most 2)"
     )
+
+
+def ratios():
+    """Wall / simulated time of the closed, driven step run on LETE sand at the defaults and with
+    the Rosenbrock-W method, beside the paper's model in this process."""
+    (name, model), = MODELS.items()
+    against_the_paper({f"{name}, defaults": tb.Scenario.from_dict(model),
+                       f"{name}, ros34pw2 at 1e-6": tb.Scenario.from_dict({**model, **ROSENBROCK})}, REPEATS)
 
 
 def soils(speed=5.0, duration=1.0):
@@ -121,6 +130,7 @@ def slip_curve(slips=(0.05, 0.1, 0.2, 0.3, 0.4, 0.5), link_stiffness=None, durat
 
 PARTS = {
     "cost": cost,
+    "ratios": ratios,
     "soils": soils,
     "slips": slip_curve,
     "stiff_slips": lambda: slip_curve(link_stiffness=8e7),  # Wong's track is inextensible: test_drawbar's

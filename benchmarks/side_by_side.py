@@ -25,3 +25,19 @@ def best_walls(variants, repeats):
                 f"{ds.attrs['steps']} (+{ds.attrs['rejected_steps']} rejected), {ds.attrs['status']}"
             )
     return best
+
+
+def against_the_paper(variants, repeats, bar=4.0):
+    """Wall / simulated time of each of {name: Scenario} beside the paper's model (paper_step at
+    its defaults), run alternately in this process, best of `repeats`; a table of the ratios
+    against the bar (docs/benchmarks.md: at most 4x the paper model's)."""
+    paper = "the paper's model"
+    scs = {paper: tb.Scenario.paper(), **variants}
+    best = best_walls(scs, repeats)
+    base = best[paper] / scs[paper]["duration"]
+    print(f"\n| run | wall / simulated | / the paper model's | bar {bar:g}x |\n| --- | --- | --- | --- |")
+    for name, sc in scs.items():
+        ratio = best[name] / sc["duration"]
+        met = "" if name == paper else ("met" if ratio / base <= bar else "**not met**")
+        print(f"| {name} | {ratio:.3f} | {ratio / base:.1f}x | {met} |")
+    return best

@@ -1,6 +1,7 @@
 """Where the step goes: which state component carries the error norm of the steps of a
-run, for the explicit pair (DOPRI5) and the IMEX pair (ARK5(4)8L[2]SA). Prints figures;
-asserts nothing; takes a minute or two.
+run, for the explicit pair (DOPRI5), the IMEX pair (ARK5(4)8L[2]SA) and the Rosenbrock-W
+method (ROS34PW2, its pins' velocities at its default multiple of the tolerance). Prints
+figures; asserts nothing; takes a minute or two.
 
 A copy of each method's step in Python (the compiled right-hand side and pin Jacobian, the
 same tables and error norms, the plain controller of solvers/common/control.py without event
@@ -12,6 +13,7 @@ stuck (|vx| < 0.05 m/s) or sliding, or off the ground), or a body coordinate.
     python benchmarks/step_profile.py                 # regularised friction, 0.20-0.23 s
     python benchmarks/step_profile.py --start 0.35 --window 0.02 --tolerance 1e-8
     python benchmarks/step_profile.py --set contact.friction_law=bristle
+    python benchmarks/step_profile.py --methods ros34pw2 --tolerance 1e-6 --start 0.35 --window 0.05
 """
 
 import argparse
@@ -28,6 +30,8 @@ from trackbench.solvers.common.control import FAC_MIN, SAFETY
 from trackbench.solvers.imex.ark_tableau import ARK_TABLEAUS
 from trackbench.solvers.registry import SOLVERS, run_function
 from trackbench.solvers.rk.tableau import TABLEAUS
+from trackbench.solvers.rosenbrock import ros_run
+from trackbench.solvers.rosenbrock.ros_tableau import ROS_TABLEAUS
 
 S = importlib.import_module("trackbench.run.simulate")
 CLOSED = {"track.layout": "closed", "preset": "damped", "contact.friction": 0.6,
@@ -52,7 +56,7 @@ class Window:
         self.pin_of = {}
         for b in range(self.jw.blk.shape[0]):
             for c, k in enumerate(self.jw.blk[b]):
-                self.pin_of[k] = (b, "x y vx vy".split()[c])
+                self.pin_of[k] = (b, "x y vx vy z".split()[c])
 
     def f(self, y):
         out = np.empty(self.ny)
@@ -76,8 +80,22 @@ class Window:
 
 
 def _scaled(w, y, yn, er, tol):
+    """The squared terms of the error norm over (q, qd); tol a number or one per component."""
     sc = tol + tol * np.maximum(np.abs(y), np.abs(yn))
     return (er[: 2 * w.nq] / sc[: 2 * w.nq]) ** 2
+
+
+def ros_step(w, y, f0, h, tol, tab):
+    """ROS34PW2 as solvers/rosenbrock/ros_loop.py takes it (transformed variables, the
+    velocity part's solve)."""
+    s, hg = tab.m.size, h * tab.gamma
+    PJ.factor_velocities(hg, w.jw)
+    U = np.zeros((s, w.ny))
+    for i in range(s):
+        fi = f0 if i == 0 else w.f(y + tab.A[i, :i] @ U[:i])
+        PJ.solve_velocities(hg, w.nq, w.jw, fi + tab.C[i, :i] @ U[:i] / h, U[i])
+    yn = y + tab.m @ U
+    return yn, w.f(yn), _scaled(w, y, yn, tab.e @ U, tol)
 
 
 def dopri5_step(w, y, f0, h, tol, tab):
@@ -107,28 +125,39 @@ def ark_step(w, y, f0, h, tol, tab):
     return yn, w.f(yn), _scaled(w, y, yn, er, tol)
 
 
+def _method(method, w, tol):
+    """(table, step, Jacobian age, tolerance per component) of a method: the Rosenbrock-W
+    method's pins' velocities at its default multiple of tol (ros_run.PIN_VELOCITY_RATIO)."""
+    if method in TABLEAUS:
+        return TABLEAUS[method].arrays(), dopri5_step, None, tol
+    if method in ARK_TABLEAUS:
+        return ARK_TABLEAUS[method].arrays(), ark_step, PJ.J_AGE, tol
+    tols = np.full(w.ny, tol)
+    lo, hi = ros_run.pin_velocities(w.jw)
+    tols[lo:hi] = ros_run.PIN_VELOCITY_RATIO * tol
+    return ROS_TABLEAUS[method].arrays(), ros_step, ros_run.JACOBIAN_AGE, tols
+
+
 def profile(w, method, window, tol):
-    explicit = method in TABLEAUS
-    tab = TABLEAUS[method].arrays() if explicit else ARK_TABLEAUS[method].arrays()
-    step = dopri5_step if explicit else ark_step
+    tab, step, j_age, tol = _method(method, w, tol)
     y, h, t = w.y0.copy(), 1e-6, 0.0
     f0 = w.f(y)
-    counts, hs, rejected, age = collections.Counter(), [], 0, PJ.J_AGE
+    counts, hs, rejected, age, in_row = collections.Counter(), [], 0, j_age, 0
     while t < window:
-        if not explicit and age >= PJ.J_AGE:
+        if j_age is not None and (age >= j_age or in_row >= PJ.J_REJECTIONS):
             PJ.pin_jacobian(y, f0, w.model.arrays, w.model.work, w.jw, w.diag)
-            age = 0
+            age, in_row = 0, 0
         yn, fn, r = step(w, y, f0, h, tol, tab)
         err = np.sqrt(r.mean())
         fac = SAFETY * err ** tab.expo if err > 0 else 10.0
         if not err <= 1.0:
             rejected += 1
-            age = PJ.J_AGE
+            in_row += 1 if age else 0
             h *= max(FAC_MIN, fac)
             continue
         counts[w.kind(int(np.argmax(r)), yn)] += 1
         hs.append(h)
-        t, y, f0, age = t + h, yn, fn, age + 1
+        t, y, f0, age, in_row = t + h, yn, fn, (age or 0) + 1, 0
         h *= min(10.0, fac)
     return counts, np.array(hs), rejected
 

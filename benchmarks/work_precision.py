@@ -73,9 +73,22 @@ def default_methods(solver="reduced"):
     return list(SOLVERS[solver].methods)
 
 
-def variants(methods=None, tolerances=TOLERANCES):
-    """[{"method": m, "tolerance": tol}] for every method (default: the registry's) and tolerance."""
-    return [{"method": m, "tolerance": float(t)} for m in methods or default_methods() for t in tolerances]
+# the methods whose error norm holds the pins' velocities to tolerance_pin_velocity
+PIN_METHODS = ("ros34pw2",)
+
+
+def variants(methods=None, tolerances=TOLERANCES, pin_ratios=(1.0,)):
+    """[{"method": m, "tolerance": tol}] for every method (default: the registry's) and tolerance;
+    for PIN_METHODS one per ratio r of pin_ratios, with tolerance_pin_velocity = r tol."""
+    out = []
+    for m in methods or default_methods():
+        for t in tolerances:
+            for r in pin_ratios if m in PIN_METHODS else (None,):
+                v = {"method": m, "tolerance": float(t)}
+                if r is not None:
+                    v["tolerance_pin_velocity"] = float(f"{r * float(t):.12g}")
+                out.append(v)
+    return out
 
 
 def command_line(argv, parts):
@@ -85,13 +98,17 @@ def command_line(argv, parts):
     p.add_argument("parts", nargs="*")
     p.add_argument("--methods", default=None, help="comma-separated (default: the registry's)")
     p.add_argument("--tolerances", default=",".join(f"{t:g}" for t in TOLERANCES))
+    # the criterion part: benchmarks/accuracy.py
     p.add_argument("--repeats", type=int, default=REPEATS, help="timing rounds (best of)")
+    p.add_argument("--pin-ratios", default="1", help="tolerance_pin_velocity / tolerance, comma-separated")
     a = p.parse_args(argv)
     unknown = [n for n in a.parts if n not in parts]
     if unknown:
         p.error(f"unknown part(s) {', '.join(unknown)}; parts: {', '.join(parts)}")
     methods = a.methods.split(",") if a.methods else None
-    return a.parts or list(parts), variants(methods, [float(t) for t in a.tolerances.split(",")]), a.repeats
+    tolerances = [float(t) for t in a.tolerances.split(",")]
+    vs = variants(methods, tolerances, [float(r) for r in a.pin_ratios.split(",")])
+    return a.parts or list(parts), vs, a.repeats
 
 
 def _label(column):
@@ -243,7 +260,7 @@ def _line(name, fig, ref, first_solve):
     return _row(
         [
             name[0],
-            f"{name[1]:.0e}",
+            f"{name[1]:.0e}" + (f" (pins {name[2]:.0e})" if len(name) > 2 else ""),
             fig["status"],
             f"{fig['solve']:.2f}",
             f"{fig['wall']:.2f}",
@@ -301,7 +318,8 @@ def precision(name, model, vs, repeats=REPEATS):
     best = {}
     for _ in range(max(repeats, 1)):  # the variants alternate round after round
         for v in vs:
-            best[(v["method"], v["tolerance"])] = run(model, v, again=True)
+            pins = (v["tolerance_pin_velocity"],) if "tolerance_pin_velocity" in v else ()
+            best[(v["method"], v["tolerance"], *pins)] = run(model, v, again=True)
     print()
     print(_row(HEAD))
     print(_row(["---"] * len(HEAD)))
@@ -368,7 +386,7 @@ def spread(name, model, vs):
 def main(argv, parts, models):
     """Run a benchmark script's parts named on its command line; the "precision" and "spread"
     parts run precision() and spread() on each of `models` (name -> scenario overrides)."""
-    names, vs, repeats = command_line(argv, [*parts, "precision", "spread"])
+    names, vs, repeats = command_line(argv, [*parts, "precision", "spread", "criterion"])
     for name in names:
         if name in parts:
             parts[name]()
@@ -377,3 +395,7 @@ def main(argv, parts, models):
                 precision(label, model, vs, repeats)
             elif name == "spread":
                 spread(label, model, vs)
+            elif name == "criterion":
+                import accuracy
+
+                accuracy.criterion(label, model, vs, repeats)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from . import ScenarioError
-from .parameters_table import PLACEMENT_KEYS, parameter_names
+from .parameters_table import OPTIONAL, PLACEMENT_KEYS, parameter_names
 
 
 def unknown(name, valid):
@@ -90,7 +90,7 @@ def merge(base, over, prefix=""):
     group raise ScenarioError."""
     for k, v in over.items():
         name = prefix + k
-        if k not in base and not name.startswith("terrain"):
+        if k not in base and name not in OPTIONAL and not name.startswith("terrain"):
             raise unknown(name, parameter_names())
         if name == "terrain":
             _merge_terrain(base, v)

@@ -315,6 +315,18 @@ OBSTACLE_KEYS = {
     "halfround": {"radius", "position", "gap"},
 }
 
+# --- The pins' velocities' own tolerance (solvers/base.py: the error norm) --------------------
+# Optional: absent from the paper's defaults, so that a scenario that does not set it resolves
+# (and hashes: study run ids, the recorded runs' attributes) as before. Unset, method =
+# "ros34pw2" holds the pins' velocities to its default multiple of `tolerance`
+# (solvers/rosenbrock/ros_run.py); the other methods hold every component to `tolerance`.
+OPTIONAL = ("tolerance_pin_velocity",)
+RULES["tolerance_pin_velocity"] = (
+    float, 0.0, 1e-3,
+    "a number in (0, 1e-3]: the pins' velocities' tolerance of method ros34pw2 (unset: its default)",
+)
+OPEN_LOW.add("tolerance_pin_velocity")
+
 
 def parameter_names():
     """Every dotted name a scenario accepts (terrain keys included)."""

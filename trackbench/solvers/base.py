@@ -11,9 +11,10 @@ entry says ``streams``, ``run(model, y0, controls, sink=None)``), where
   reduced state at t = 0 (q, qd, extras, bristle deflections: model/core/indices.py);
 - ``controls`` is a ``Controls``, built once per run by the run layer from the validated
   scenario (registry.SolverEntry.controls): t_end, the output interval, the tolerances, the
-  step limits (h0, h_max, h_min, max_steps), the number of samples, the method it runs, and
-  its own settings table (``controls.settings``: e.g. lee's ``accel_order``); the compiled
-  loops take its numeric part, ``controls.loop_control`` (a ``Control``).
+  step limits (h0, h_max, h_min, max_steps), the number of samples, the method it runs, its
+  own settings table (``controls.settings``: e.g. lee's ``accel_order``) and the pins'
+  velocities' own tolerance where the scenario sets one; the compiled loops take its numeric
+  part, ``controls.loop_control`` (a ``Control``).
 
 The solver:
 
@@ -24,7 +25,13 @@ The solver:
    (model/core/indices.py): every output means the same whichever solver made it;
 3. controls its step by an error estimate and never steps over a contact switch: an onset
    or release inside a rejected step is located (solvers/common/events.py) and the retry
-   ends just after it;
+   ends just after it. In the reduced solver the estimate's norm is an RMS over q, qd and the
+   bristles' deflections (never the extras: work quadratures, the drive's integral) of
+   e_k / (tol_k (1 + max(|y_k|, |y_new,k|))) (DOP853: Hairer's combination of its two
+   estimates), tol_k = ``controls.rtol`` (= atol, the scenario's tolerance) for every
+   component, except that a method whose registry entry says so (ros34pw2) holds the pins'
+   velocities to ``controls.tolerance_pin_velocity`` (0: the method's default;
+   solvers/common/stepping.py error_norm_pins);
 4. chooses its step by its error control alone (from ``h0``, up to ``h_max``), whatever the
    output interval, and fills ``Outputs`` (``allocate_outputs``): samples at t_k = k dt_out
    from its dense output between accepted steps, the peaks over every accepted step
@@ -107,6 +114,10 @@ class Controls:
     n_samples: int    # the output grid's samples, t = 0 and the last included
     method: str       # the method the solver runs (its entry's method, or its label)
     settings: dict = field(default_factory=dict)   # the solver's own table (registry: settings)
+    # the pins' velocities' own tolerance in the error norm (the scenario's tolerance_pin_velocity;
+    # 0: not set, the method's default); the methods that read it say so in their registry entry
+    # (contract point 3)
+    tolerance_pin_velocity: float = 0.0
 
     @property
     def loop_control(self):
@@ -115,7 +126,8 @@ class Controls:
                        self.max_steps, self.n_samples)
 
 
-def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, method="", settings=None):
+def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, method="", settings=None,
+             tolerance_pin_velocity=0.0):
     """The Controls of a run from its settings. The step is the error control's alone,
     whatever the output interval (samples come from the dense output), up to ``max_step``
     where one is set (0: none)."""
@@ -123,7 +135,8 @@ def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, me
     dt_out = float(output_interval)
     h_max = min(float(max_step) or t_end, (CHUNK_ROWS - 1) * dt_out)
     return Controls(t_end, dt_out, float(tolerance), float(tolerance), min(H0, h_max), h_max, H_MIN,
-                    step_cap(max_steps, t_end), n_samples(t_end, dt_out), method, dict(settings or {}))
+                    step_cap(max_steps, t_end), n_samples(t_end, dt_out), method, dict(settings or {}),
+                    float(tolerance_pin_velocity or 0.0))
 
 
 STEPS_PER_SECOND = 400_000   # max_steps = 0: the closed track with friction takes ~160,000 a second

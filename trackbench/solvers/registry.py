@@ -56,7 +56,16 @@ class SolverEntry:
 
         own = dict(scenario[self.settings]) if self.settings else {}
         return controls(scenario["duration"], scenario["output_interval"], scenario["tolerance"],
-                        scenario["max_step"], scenario["max_steps"], self.method_of(scenario["method"]), own)
+                        scenario["max_step"], scenario["max_steps"], self.method_of(scenario["method"]), own,
+                        _optional(scenario, "tolerance_pin_velocity"))
+
+
+def _optional(scenario, name):
+    """A setting the paper's defaults leave out (absent: 0, the method's own default)."""
+    try:
+        return scenario[name]
+    except KeyError:
+        return 0.0
 
 
 _LEE_SETTINGS = (
@@ -74,13 +83,15 @@ SOLVERS = {
         SolverEntry(
             "reduced",
             "trackbench.solvers.rk.rk_run",
-            ("dop853", "dopri5", "ark436l2sa", "ark548l2sa"),
-            "reduced coordinates, embedded explicit Runge-Kutta pairs (DOP853, DOPRI5) or additive "
+            ("dop853", "dopri5", "ark436l2sa", "ark548l2sa", "ros34pw2"),
+            "reduced coordinates, embedded explicit Runge-Kutta pairs (DOP853, DOPRI5), additive "
             "(IMEX) pairs with the pins' block Jacobian as the implicit part (ARK4(3)6L[2]SA, "
-            "ARK5(4)8L[2]SA)",
+            "ARK5(4)8L[2]SA), or the Rosenbrock-W method ROS34PW2 with the pins' block Jacobian as "
+            "its W (its error norm holds the pins' velocities to tolerance_pin_velocity)",
             method_modules=(
                 ("ark436l2sa", "trackbench.solvers.imex.ark_run"),
                 ("ark548l2sa", "trackbench.solvers.imex.ark_run"),
+                ("ros34pw2", "trackbench.solvers.rosenbrock.ros_run"),
             ),
             closed_track=True,
             extended_models=True,

@@ -1,6 +1,7 @@
 """Dense output of a step of a second-order system, written once: the quintic Hermite
 interpolant through (q, qd, qdd) at both ends of the step (positions), its derivative
-(velocities) and the cubic Hermite for first-order components (the contact work)."""
+(velocities) and the cubic Hermite for first-order components (the contact work); for a
+method of order 3, the cubic Hermite through (qd, qdd) for the velocities instead."""
 
 from numba import njit
 
@@ -62,4 +63,22 @@ def hermite_second_order(y0, f0, y1, f1, h, theta, nq, out):
     c01 = -2.0 * t3 + 3.0 * t2
     c11 = t3 - t2
     for k in range(2 * nq, y0.shape[0]):
+        out[k] = c00 * y0[k] + h * c10 * f0[k] + c01 * y1[k] + h * c11 * f1[k]
+
+
+@njit(**BORROW)
+def hermite_velocities(y0, f0, y1, f1, h, theta, nq, out):
+    """The velocities qd at t0 + theta h by the cubic Hermite interpolant through (qd, qdd) at
+    both ends, into out[nq:2 nq]: for a method of order 3 (the Rosenbrock-W loop's samples).
+    The derivative of the quintic (hermite_second_order) takes (q1 - q0) / h, whose end error
+    h^4 / h leaves velocities of order 2 between the ends of such a step; this one is of
+    order 3 (tests/test_ros_tableau.py). Positions stay the quintic's."""
+    t = theta
+    t2 = t * t
+    t3 = t2 * t
+    c00 = 2.0 * t3 - 3.0 * t2 + 1.0
+    c10 = t3 - 2.0 * t2 + t
+    c01 = -2.0 * t3 + 3.0 * t2
+    c11 = t3 - t2
+    for k in range(nq, 2 * nq):
         out[k] = c00 * y0[k] + h * c10 * f0[k] + c01 * y1[k] + h * c11 * f1[k]

@@ -56,16 +56,30 @@ J_REJECTIONS = 2     # rejections in a row after which it is renewed
 
 def ring_colours(n, closed, reach=2):
     """Colours of pins 0..n-1 along a chain (closed: a ring) such that pins of one colour are
-    at least three apart: neither neighbours nor sharing a neighbour. Greedy, in order."""
+    at least reach + 1 apart (reach 2: neither neighbours nor sharing a neighbour). Runs of
+    0, 1, .., reach (a chain: all of them), on a ring whose length they do not divide ending
+    in enough runs one longer (0, .., reach + 1): reach + 2 colours, the fewest such a ring
+    takes (the greedy colouring below, the fallback, took 5 for the closed track's 65 pins)."""
+    p = reach + 1
+    q, rem = divmod(n, p)
+    if not closed or rem == 0 or q >= rem:
+        sizes = [p] * (q - (rem if closed else 0)) + ([p + 1] * rem if closed else [rem] if rem else [])
+        colour = [c for size in sizes for c in range(size)]
+        return _groups(colour)
     colour = []
     for b in range(n):
         near = range(1, reach + 1)
         taken = {colour[b - d] for d in near if b - d >= 0}
         if closed:
             taken |= {colour[(b + d) % n] for d in near if (b + d) % n < b}
-        colour.append(min(set(range(5)) - taken))
+        colour.append(min(set(range(2 * reach + 1)) - taken))
+    return _groups(colour)
+
+
+def _groups(colour):
+    """(n_colours, n_per) pins of each colour, -1 padded."""
     n_col = max(colour) + 1
-    groups = [[b for b in range(n) if colour[b] == c] for c in range(n_col)]
+    groups = [[b for b, c_b in enumerate(colour) if c_b == c] for c in range(n_col)]
     out = np.full((n_col, max(len(g) for g in groups)), -1, dtype=np.int64)
     for c, g in enumerate(groups):
         out[c, : len(g)] = g
@@ -112,7 +126,9 @@ def _perturb(y, jw, pins, j):
 def pin_jacobian(y, f0, m, w, jw, diag):
     """The pins' blocks of J at (y, f0 = f(y)) by forward differences; returns the number of
     right-hand sides it took. Leaves w as evaluated at a perturbed state: call it before a
-    step's stages, never between the step's end and the memories' moves."""
+    step's stages, never between the step's end and the memories' moves. f0 must be f with the
+    memories as they are now: not the last step's f(y_new) once the soil's memory has moved
+    after it (each difference would carry the memory's jump over a 1e-9 perturbation)."""
     blk, jac, nb = jw.blk, jw.jac, jw.blk.shape[1]
     for b in range(blk.shape[0]):
         for r in range(N_KINEMATIC):
@@ -214,3 +230,83 @@ def solve(hg, nq, jw, r, u):
         _block_solve(b, jw, rb)
         for j in range(nb):
             u[blk[b, j]] = rb[j]
+
+
+# --- The same solve by the blocks' structure (the Rosenbrock-W loop's) ------------------------
+# A block of J is [[0, I, 0], [0, D]] over (x, y | vx, vy (| z)): its position columns are 0
+# (scale 0: not differenced) and its position rows the kinematic identity. So (I / (h gamma) -
+# J) u = r is (I / (h gamma) - D) u_v = r_v, then u_x = h gamma (r_x + u_v): an LU of the
+# (nb - 2)-square velocity part D (a 2x2 one inverted outright), a fraction of the whole
+# block's work.
+
+
+@njit(**BORROW)
+def factor_velocities(hg, jw):
+    """Each block's velocity part I / (h gamma) - D, in rows and columns N_KINEMATIC.. of jw.lu:
+    a 2x2 part (no bristles) as its inverse; a larger one as LU factors (partial pivoting, a
+    fixed order)."""
+    lu, piv, nb = jw.lu, jw.piv, jw.blk.shape[1]
+    k = N_KINEMATIC
+    for b in range(lu.shape[0]):
+        for r in range(N_KINEMATIC, nb):
+            for j in range(N_KINEMATIC, nb):
+                lu[b, r, j] = (1.0 / hg if r == j else 0.0) - jw.jac[b, r, j]
+        if nb == k + 2:
+            a, c, d, e = lu[b, k, k], lu[b, k, k + 1], lu[b, k + 1, k], lu[b, k + 1, k + 1]
+            det = a * e - c * d
+            lu[b, k, k], lu[b, k, k + 1] = e / det, -c / det
+            lu[b, k + 1, k], lu[b, k + 1, k + 1] = -d / det, a / det
+            continue
+        for col in range(N_KINEMATIC, nb):
+            p = col
+            for r in range(col + 1, nb):
+                if abs(lu[b, r, col]) > abs(lu[b, p, col]):
+                    p = r
+            piv[b, col] = p
+            if p != col:
+                for j in range(N_KINEMATIC, nb):
+                    lu[b, col, j], lu[b, p, j] = lu[b, p, j], lu[b, col, j]
+            for r in range(col + 1, nb):
+                lu[b, r, col] /= lu[b, col, col]
+                for j in range(col + 1, nb):
+                    lu[b, r, j] -= lu[b, r, col] * lu[b, col, j]
+
+
+@njit(**BORROW)
+def solve_velocities(hg, nq, jw, r, u):
+    """u = (I / (h gamma) - J)^-1 r as solve(), each block by its velocity part's factors
+    (factor_velocities), then its positions."""
+    for k in range(2 * nq, r.shape[0]):
+        u[k] = hg * r[k]
+    for i in range(jw.free.shape[0]):
+        k = jw.free[i]
+        u[nq + k] = hg * r[nq + k]
+        u[k] = hg * (r[k] + u[nq + k])
+    blk, rb, lu, piv, nb = jw.blk, jw.rb, jw.lu, jw.piv, jw.blk.shape[1]
+    k = N_KINEMATIC
+    if nb == k + 2:   # the inverses of factor_velocities
+        for b in range(blk.shape[0]):
+            ix, iy, ivx, ivy = blk[b, 0], blk[b, 1], blk[b, k], blk[b, k + 1]
+            vx = lu[b, k, k] * r[ivx] + lu[b, k, k + 1] * r[ivy]
+            vy = lu[b, k + 1, k] * r[ivx] + lu[b, k + 1, k + 1] * r[ivy]
+            u[ivx], u[ivy] = vx, vy
+            u[ix], u[iy] = hg * (r[ix] + vx), hg * (r[iy] + vy)
+        return
+    for b in range(blk.shape[0]):
+        for j in range(N_KINEMATIC, nb):
+            rb[j] = r[blk[b, j]]
+        for col in range(N_KINEMATIC, nb):
+            p = piv[b, col]
+            if p != col:
+                rb[col], rb[p] = rb[p], rb[col]
+            for i in range(col + 1, nb):
+                rb[i] -= lu[b, i, col] * rb[col]
+        for i in range(nb - 1, N_KINEMATIC - 1, -1):
+            s = rb[i]
+            for j in range(i + 1, nb):
+                s -= lu[b, i, j] * rb[j]
+            rb[i] = s / lu[b, i, i]
+        for j in range(N_KINEMATIC, nb):
+            u[blk[b, j]] = rb[j]
+        for j in range(N_KINEMATIC):
+            u[blk[b, j]] = hg * (r[blk[b, j]] + rb[j + N_KINEMATIC])

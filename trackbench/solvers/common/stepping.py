@@ -10,6 +10,7 @@ from collections import namedtuple
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from ...model.contact.onsets import remember_onsets
 from ...model.core.indices import (
@@ -36,13 +37,13 @@ from ...model.core.indices import (
     S_E0,
     Y_WORK,
 )
-from ...model.core.jit import BORROW, INLINE
+from ...model.core.jit import BORROW, INLINE, KERNEL
 from ...model.dynamics.rhs import rhs
 from ...model.ground.memory import has_ground_memory, remember_ground
 from ...status import NAN, SUCCESSFUL
 from .arrays import copy_into, set_row
 from .control import loop_start
-from .hermite import hermite_second_order
+from .hermite import hermite_second_order, hermite_velocities
 from .monitor import energy_balance, energy_residual, init_peaks, update_peaks
 from .sinkage import remember_inside_step
 
@@ -127,6 +128,29 @@ def chunk_full(t, h, n_out, ctl, out):
     return n - int(out.resume[RS_BASE]) > out.y.shape[0]
 
 
+def _cubic_velocities(lw):
+    """Whether the loop's scratch asks for velocities of order 3 (its class says
+    CUBIC_VELOCITIES = True: the Rosenbrock-W loop's)."""
+    return getattr(getattr(lw, "instance_class", None), "CUBIC_VELOCITIES", False)
+
+
+def dense_state(y0, f0, y1, f1, h, theta, nq, lw):
+    """The state at t0 + theta h of the step (y0, f0) -> (y1, f1) into lw.ys: hermite.py's
+    quintic for positions and its derivative for velocities, or, for a loop of order 3 (by the
+    type of lw), the cubic Hermite of the velocities themselves."""
+    raise NotImplementedError("compiled only")
+
+
+@overload(dense_state, jit_options=KERNEL)
+def _dense_state_impl(y0, f0, y1, f1, h, theta, nq, lw):
+    if _cubic_velocities(lw):
+        def cubic(y0, f0, y1, f1, h, theta, nq, lw):
+            hermite_second_order(y0, f0, y1, f1, h, theta, nq, lw.ys)
+            hermite_velocities(y0, f0, y1, f1, h, theta, nq, lw.ys)
+        return cubic
+    return lambda y0, f0, y1, f1, h, theta, nq, lw: hermite_second_order(y0, f0, y1, f1, h, theta, nq, lw.ys)
+
+
 @njit(**INLINE)
 def samples(t, h, n_out, ctl, m, w, lw, out):
     """Output samples in (t, t + h] by Hermite interpolation into the chunk's rows; returns the
@@ -140,7 +164,7 @@ def samples(t, h, n_out, ctl, m, w, lw, out):
     base = int(out.resume[RS_BASE])
     while n_out < ctl.n_samples and n_out * dt_out <= t_new * (1.0 + 1e-12):
         theta = min(1.0, (n_out * dt_out - t) / h)
-        hermite_second_order(y, K[0], y_new, K[s], h, theta, nq, ys)
+        dense_state(y, K[0], y_new, K[s], h, theta, nq, lw)
         set_row(out_y, n_out - base, ys)
         rhs(ys, m, w, fs, out_diag[n_out - base])
         n_out += 1
@@ -177,6 +201,21 @@ def error_norm(y, y_new, er, rtol, atol, n):
     s = _squares(y, y_new, er, rtol, atol, 0, n)
     if ny > n + N_Y_EXTRA:   # the bristle law's states
         s += _squares(y, y_new, er, rtol, atol, n + N_Y_EXTRA, ny)
+    return math.sqrt(s / (ny - N_Y_EXTRA))
+
+
+@njit(**INLINE)
+def error_norm_pins(y, y_new, er, tol, n, pins):
+    """error_norm with tolerances per component: the pins' velocities, components pins = (lo,
+    hi, tol_v) lo..hi-1, held to tol_v (atol = rtol = tol_v), every other one to tol; the RMS
+    over the same components (q, qd, the bristle deflections). The Rosenbrock-W method's."""
+    lo, hi, tol_v = pins
+    ny = y.shape[0]
+    s = _squares(y, y_new, er, tol, tol, 0, lo)
+    s += _squares(y, y_new, er, tol_v, tol_v, lo, hi)
+    s += _squares(y, y_new, er, tol, tol, hi, n)
+    if ny > n + N_Y_EXTRA:   # the bristle law's states
+        s += _squares(y, y_new, er, tol, tol, n + N_Y_EXTRA, ny)
     return math.sqrt(s / (ny - N_Y_EXTRA))
 
 

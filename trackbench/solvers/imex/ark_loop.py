@@ -23,6 +23,7 @@ from ...model.contact.onsets import onset_in_step
 from ...model.core.indices import PN_NQ, RS_AGE, RS_IN_ROW, RS_N_OUT
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
+from ...model.ground.memory import has_ground_memory
 from ...status import SUCCESSFUL
 from ..common.control import (
     FAC_MAX,
@@ -129,7 +130,11 @@ def integrate(y0, ctl, tab, m, w, ev, lw, jw, out):
             out.resume[RS_AGE], out.resume[RS_IN_ROW] = age, in_row
             return
         if age >= J_AGE or in_row >= J_REJECTIONS:
-            n_rhs += pin_jacobian(y, K[0], m, w, jw, lw.diag)
+            if has_ground_memory(m.par):   # f at y with the soil's memory as moved since K[0]
+                rhs(y, m, w, lw.fs, lw.diag)
+                n_rhs += 1 + pin_jacobian(y, lw.fs, m, w, jw, lw.diag)
+            else:
+                n_rhs += pin_jacobian(y, K[0], m, w, jw, lw.diag)
             age = 0
             in_row = 0
         n_rhs += _step(h, tab, m, w, lw, jw)

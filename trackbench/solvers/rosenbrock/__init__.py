@@ -1,0 +1,1 @@
+"""Linearly implicit Rosenbrock-W methods with the pins' block Jacobian."""
