@@ -6,6 +6,10 @@ far its figures land from a tight reference run. Used by bench_closed.py and ben
     python benchmarks/bench_closed.py spread --methods dopri5 --tolerances 1e-8
     python benchmarks/bench_soil.py precision spread --repeats 1
 
+criterion: benchmarks/accuracy.py (the reference ensembles, each variant judged beside the
+paper's model). --pin-ratios 1,10 gives the methods that take tolerance_pin_velocity (PIN_METHODS)
+one variant per ratio of it to the tolerance.
+
 A variant is a dict of scenario overrides, {"method": ..., "tolerance": ...}: a method the
 registry does not know yet (a Rosenbrock-W method under way, say) gets a line saying so and
 the others run. The default methods are those of solvers.registry.SOLVERS["reduced"].

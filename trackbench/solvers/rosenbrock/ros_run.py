@@ -33,7 +33,8 @@ def ros_control(controls, jw, jacobian_age=None):
     """The loop's RosControl: the pins' velocities and their tolerance, the accepted steps one
     W serves (None: JACOBIAN_AGE, as this module holds it when the run starts)."""
     lo, hi = pin_velocities(jw)
-    tol_v = controls.tolerance_pin_velocity or PIN_VELOCITY_RATIO * controls.rtol
+    # rounded to 12 digits: 10 x 1e-6 is 1e-5 exactly, as a scenario that sets it says
+    tol_v = controls.tolerance_pin_velocity or float(f"{PIN_VELOCITY_RATIO * controls.rtol:.12g}")
     return RosControl(lo, hi, float(tol_v), int(jacobian_age or JACOBIAN_AGE))
 
 
