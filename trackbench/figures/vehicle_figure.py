@@ -62,13 +62,11 @@ def _closed_parts(ax, st):
         ax.text(x, y, name, ha="center", va="center", **_TEXT)
 
 
-def vehicle_figure(st, path):
-    """Write the side view of Statics st to path (PNG); returns the path."""
+def draw_vehicle(ax, st):
+    """Draw Statics st on the axes ax: hull, wheels and arms, track, closed-track parts,
+    mass centre, seat, the ground, each named."""
     from matplotlib.patches import Polygon
 
-    plt = _plt()
-    sc = st.scenario
-    fig, ax = plt.subplots(figsize=(10, 4.2))
     hull = _hull(st)
     ax.add_patch(Polygon(hull, closed=True, facecolor="#e9edf2", edgecolor="#3c3c3c", lw=1.5, zorder=2))
     ax.text(
@@ -76,13 +74,14 @@ def vehicle_figure(st, path):
     )
     _wheels(ax, st)
     _track(ax, st)
-    if sc["track.layout"] == "closed":
+    if st.scenario["track.layout"] == "closed":
         _closed_parts(ax, st)
     cg = st.world([0.0, 0.0])[0]
     ax.plot(*cg, marker="$\\oplus$", ms=12, color="#b22222", zorder=6)
     ax.text(cg[0], cg[1] + 0.07, "mass centre", ha="center", **_TEXT)
     ax.plot(*st.seat, "s", color="#b22222", ms=6, zorder=6)
-    ax.text(st.seat[0], st.seat[1] + 0.07, "seat", ha="center", **_TEXT)
+    # the seat's name below it: clear of the mass centre's above
+    ax.text(st.seat[0], st.seat[1] - 0.07, "seat", ha="center", va="top", **_TEXT)
     lo, hi = (
         min(hull[:, 0].min(), st.pins[:, 0].min()) - 0.5,
         max(hull[:, 0].max(), st.pins[:, 0].max()) + 0.5,
@@ -103,6 +102,14 @@ def vehicle_figure(st, path):
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
+
+
+def vehicle_figure(st, path):
+    """Write the side view of Statics st to path (PNG); returns the path."""
+    plt = _plt()
+    sc = st.scenario
+    fig, ax = plt.subplots(figsize=(10, 4.2))
+    draw_vehicle(ax, st)
     ax.set_title(
         f"{sc['vehicle.model']} at rest: {st.eq.weight / sc['gravity'] / 1e3:.2f} t, "
         f"{sc['vehicle.n_wheels']} road wheels, {sc['track.layout']} track",
