@@ -116,6 +116,9 @@ def _values(label, doc):
 
 @functools.lru_cache(maxsize=1)
 def known_names():
-    """Every dotted name a vehicle file may set: the reference file's."""
+    """Every dotted name a vehicle file may set: the reference file's, and the optional ones
+    the paper's vehicle has not (the bump stops, the torsion bars' free angle)."""
+    from trackbench.model.vehicle.parameters import ARM_OPTIONS
+
     doc = tomllib.loads(catalogue_path(REFERENCE).read_text(encoding="utf-8"))
-    return frozenset(f"{g}.{k}" for g in GROUPS for k in doc.get(g, {}))
+    return frozenset(f"{g}.{k}" for g in GROUPS for k in doc.get(g, {})) | {f"vehicle.{k}" for k in ARM_OPTIONS}
