@@ -24,7 +24,8 @@ def _degrees(phi):
      "vehicle.rebound_stop_angle = 44 deg (wheel 3) must lie above"),
     ({"vehicle.bump_stop_stiffness": 1e6}, "vehicle.bump_stop_stiffness is set but no stop"),
     ({"vehicle.bump_stop_stiffness": -1.0}, "vehicle.bump_stop_stiffness = -1.0 is not allowed"),
-    ({"vehicle.torsion_free_angle": [50.0, 50.0]}, "vehicle.torsion_free_angle has 2 values for 5 road wheels"),
+    ({"vehicle.torsion_free_angle": [50.0, 50.0]},
+     "vehicle.torsion_free_angle has 2 values for 5 road wheels"),
     ({"vehicle.jounce_stop_angle": "low"}, "vehicle.jounce_stop_angle = 'low' is not allowed"),
 ])
 def test_bad_arm_values_fail_in_one_line(over, words):
@@ -32,6 +33,13 @@ def test_bad_arm_values_fail_in_one_line(over, words):
         tb.Scenario.paper(**over)
     msg = str(e.value)
     assert "\n" not in msg and words in msg, msg
+
+
+def test_vehicle_files_may_set_the_arm_options():
+    from trackbench.model.vehicle.parameters import ARM_OPTIONS
+    from trackbench.vehicles.loader import OPTIONAL_NAMES
+
+    assert OPTIONAL_NAMES == {f"vehicle.{k}" for k in ARM_OPTIONS}
 
 
 def test_without_the_new_keys_the_scenario_is_the_papers():

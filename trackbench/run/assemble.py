@@ -13,7 +13,6 @@ from trackbench.model.core import indices as L
 from trackbench.model.core.bundles import arm_table, model_arrays, work_arrays
 from trackbench.model.vehicle.parameters import (
     arm_damping,
-    equilibrium_arm_angle,
     free_angle,
     pack,
     station_columns,
@@ -72,8 +71,9 @@ def resting_vehicle(scenario):
 
 
 def _resting(scenario):
-    return _resting_cached(json.dumps([scenario["vehicle"]] + [scenario[k] for k in _CLOSED_GROUPS], sort_keys=True),
-                           json.dumps(soil_par(scenario)))
+    """(the vehicle at rest, its equilibrium) of a scenario with free arms (cached)."""
+    key = json.dumps([scenario["vehicle"]] + [scenario[k] for k in _CLOSED_GROUPS], sort_keys=True)
+    return _resting_cached(key, json.dumps(soil_par(scenario)))
 
 
 @functools.lru_cache(maxsize=32)
@@ -88,7 +88,8 @@ def _resting_cached(key, soil):
     vehicle, track, gravity, contact, *rest = json.loads(key)
     nw = int(vehicle["n_wheels"])
     if track["layout"] != "closed":
-        eq = _equilibrium_cached(json.dumps([vehicle, track, gravity, contact, json.loads(soil)], sort_keys=True))
+        key = json.dumps([vehicle, track, gravity, contact, json.loads(soil)], sort_keys=True)
+        eq = _equilibrium_cached(key)
         return with_rest_angles(vehicle, eq.q[L.Q_ARM:L.Q_ARM + nw]), eq
     # a path there from the design position, each solve started from the last (Newton's method
     # from a taut loop is not sure to find one; a loop built round the design position goes

@@ -149,7 +149,9 @@ def _arm_notes(sc, eq, rest):
         stop = np.broadcast_to(np.asarray(v[key], float), rest.shape)
         past = np.flatnonzero(rest < stop if side == "jounce" else rest > stop)
         for i in past:
-            lines.append(f"wheel {i + 1} rests on its {side} stop ({rest[i]:.2f} deg, the stop {stop[i]:.2f} deg)")
+            lines.append(
+                f"wheel {i + 1} rests on its {side} stop ({rest[i]:.2f} deg, the stop {stop[i]:.2f} deg)"
+            )
     return lines
 
 

@@ -15,7 +15,8 @@ rows 2i, 2i+1 of Phi):
 with p_i the pivot body point. Eq. (9): M zdd = F(z) - Phi_q^T lambda, so lambda_i is
 the force the chassis exerts on arm i at its pivot (the chassis gets -lambda_i there).
 F holds gravity, torsion bars (torque -k_t (beta_i - theta - phi0_i) on arm i, the
-reaction on the chassis; the bump stops' -k_stop x excess beyond a stop likewise), track tension and contact forces from ``track_loads.track_loads``
+reaction on the chassis; the bump stops' -k_stop x excess beyond a stop likewise), track
+tension and contact forces from ``track_loads.track_loads``
 (pins 0 and n_links ride on the chassis at the track-end body points). There are no
 velocity-dependent forces, so Eq. (9) has the form z'' = f(z, lambda) an RKN method
 integrates. Phi_q is never formed: the products are evaluated directly from the

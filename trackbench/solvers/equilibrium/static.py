@@ -106,7 +106,8 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
 
 
 def solve_closed_equilibrium(
-    vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12, max_iter=60, start=None
+    vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12, max_iter=60,
+    start=None,
 ):
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
     taut loop (model/vehicle/closed_track.py) resting on the ground, the sprocket held; or from
