@@ -11,8 +11,16 @@ import numpy as np
 from trackbench.model.contact.laws import bristle_active
 from trackbench.model.core import indices as L
 from trackbench.model.core.bundles import arm_table, model_arrays, work_arrays
-from trackbench.model.vehicle.parameters import arm_damping, pack, station_columns, total_mass
+from trackbench.model.vehicle.parameters import (
+    arm_damping,
+    free_angle,
+    pack,
+    station_columns,
+    total_mass,
+    with_rest_angles,
+)
 from trackbench.scenario import Scenario
+from trackbench.status import EquilibriumError
 
 
 @functools.lru_cache(maxsize=32)
@@ -26,9 +34,106 @@ def _closed(scenario):
     return scenario["track.layout"] == "closed"
 
 
+_CLOSED_GROUPS = ("track", "gravity", "contact", "sprocket", "idler", "rollers", "drive", "drawbar")
+
+
 def _closed_key(scenario):
-    return json.dumps([scenario[k] for k in ("vehicle", "track", "gravity", "contact", "sprocket", "idler",
-                                             "rollers", "drive", "drawbar")], sort_keys=True)
+    return json.dumps([resting_vehicle(scenario)] + [scenario[k] for k in _CLOSED_GROUPS], sort_keys=True)
+
+
+REST_ANGLE_TOLERANCE = 1e-9   # rad: the rest angles the closed track is built round, settled
+REST_ITERATIONS = 100
+REST_STEP = 0.035   # rad (2 deg)
+
+
+def carried_at(vehicle, moment):
+    """The arm angles at which each torsion bar, twisted from its free angle (bump stops
+    included), balances the given moment of the loads about its pivot (N m)."""
+    cols = station_columns(vehicle, {"pad_wheel": 0.0})
+    kt, ks = cols[L.ARMS_STIFFNESS], cols[L.ARMS_STOP_K]
+    phi0 = free_angle(vehicle)
+    phi = phi0 + moment / kt
+    for stop, beyond in ((cols[L.ARMS_JOUNCE], phi < cols[L.ARMS_JOUNCE]),
+                         (cols[L.ARMS_REBOUND], phi > cols[L.ARMS_REBOUND])):
+        on = beyond & (ks > 0.0)   # on the stop: both springs
+        phi[on] = (moment[on] + kt[on] * phi0[on] + ks[on] * stop[on]) / (kt[on] + ks[on])
+    return phi
+
+
+def resting_vehicle(scenario):
+    """The scenario's vehicle with its arms at rest: itself, unless it gives the torsion bars'
+    free angles (vehicle.torsion_free_angle); then arm_angle holds the rest angles the
+    equilibrium solves for (cached)."""
+    v = scenario["vehicle"]
+    if v.get("torsion_free_angle") is None:
+        return v
+    return _resting(scenario)[0]
+
+
+def _resting(scenario):
+    """(the vehicle at rest, its equilibrium) of a scenario with free arms (cached)."""
+    key = json.dumps([scenario["vehicle"]] + [scenario[k] for k in _CLOSED_GROUPS], sort_keys=True)
+    return _resting_cached(key, json.dumps(soil_par(scenario)))
+
+
+@functools.lru_cache(maxsize=32)
+def _resting_cached(key, soil):
+    """The rest angles of free arms: the vehicle with its arm_angle there, and its equilibrium
+    (on the paper's layout, whose track ends sit on the hull, nothing is built round the wheels:
+    one solve with the arm angles as Newton unknowns finds them).
+    The closed track's loop, the idler's slide and its derived preload are built round the
+    wheels at rest, and the rest angles follow from that loop's tension: a fixed-point
+    iteration, the loop rebuilt round the last rest angles and each solve started from the
+    last, until they change less than REST_ANGLE_TOLERANCE."""
+    vehicle, track, gravity, contact, *rest = json.loads(key)
+    nw = int(vehicle["n_wheels"])
+    if track["layout"] != "closed":
+        key = json.dumps([vehicle, track, gravity, contact, json.loads(soil)], sort_keys=True)
+        eq = _equilibrium_cached(key)
+        return with_rest_angles(vehicle, eq.q[L.Q_ARM:L.Q_ARM + nw]), eq
+    # a path there from the design position, each solve started from the last (Newton's method
+    # from a taut loop is not sure to find one; a loop built round the design position goes
+    # slack once the wheels rise, the M113's idler spring being 1e7 N/m): the arms held at
+    # arm_angle, then free, their torsion bars' free angles moved in steps of at most REST_STEP
+    # from where they hold the arms at arm_angle to the given ones, the loop rebuilt round the
+    # last rest angles at every step (held arms share the load by the pads' stiffness and come
+    # off the track unevenly: no path for them)
+    held = {k: x for k, x in vehicle.items() if k != "torsion_free_angle"}
+    eq = _closed_solve(held, track, gravity, contact, rest, soil, "at arm_angle")
+    phi = eq.q[L.Q_ARM:L.Q_ARM + nw]
+    phi0 = free_angle(vehicle)
+    steps = max(int(np.ceil(np.max(np.abs(phi0 - eq.phi0)) / REST_STEP)), 1)
+    for j in range(1, steps):
+        on_way = {**with_rest_angles(vehicle, phi), "torsion_free_angle":
+                  list(np.degrees(eq.phi0 + (phi0 - eq.phi0) * j / steps + np.pi))}
+        eq = _closed_solve(on_way, track, gravity, contact, rest, soil, "on the way to rest", eq)
+        phi = eq.q[L.Q_ARM:L.Q_ARM + nw]
+    for _ in range(REST_ITERATIONS):
+        v = with_rest_angles(vehicle, phi)
+        eq = _closed_solve(v, track, gravity, contact, rest, soil, "at rest", eq)
+        new = eq.q[L.Q_ARM:L.Q_ARM + nw]
+        change = float(np.max(np.abs(new - phi)))
+        if change < REST_ANGLE_TOLERANCE:
+            return v, eq
+        phi = new
+    raise EquilibriumError(
+        f"the rest angles of the free arms (vehicle.torsion_free_angle) did not settle in {REST_ITERATIONS} "
+        f"rounds of the closed track rebuilt round them (last change {change:.3g} rad)"
+    )
+
+
+def _closed_solve(v, track, gravity, contact, rest, soil, where, start=None):
+    """The closed layout's equilibrium with the loop built round vehicle v's wheels (uncached),
+    from the taut loop or from start."""
+    from trackbench.model.vehicle.closed_track import ClosedLayoutError, without_drawbar
+    from trackbench.solvers.equilibrium.static import solve_closed_equilibrium
+
+    try:
+        g, lp, guides = _closed_parts_cached(json.dumps([v, track, gravity, contact, *rest], sort_keys=True))
+    except ClosedLayoutError as e:
+        raise EquilibriumError(f"the closed track round the wheels {where}: {e}") from None
+    return solve_closed_equilibrium(v, track, gravity, contact, g, without_drawbar(lp), guides,
+                                    {int(k): x for k, x in json.loads(soil).items()}, start=start)
 
 
 @functools.lru_cache(maxsize=32)
@@ -59,9 +164,11 @@ def _closed_equilibrium_cached(key, soil):
 
 def equilibrium(scenario: Scenario):
     """Static equilibrium of the scenario's vehicle on flat ground (cached)."""
+    if scenario["vehicle"].get("torsion_free_angle") is not None:
+        return _resting(scenario)[1]   # found with the rest angles
     if _closed(scenario):
         return _closed_equilibrium_cached(_closed_key(scenario), json.dumps(soil_par(scenario)))
-    key = json.dumps([scenario["vehicle"], scenario["track"], scenario["gravity"], scenario["contact"],
+    key = json.dumps([resting_vehicle(scenario), scenario["track"], scenario["gravity"], scenario["contact"],
                       soil_par(scenario)], sort_keys=True)
     return _equilibrium_cached(key)
 

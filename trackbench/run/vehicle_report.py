@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from trackbench.model.core import indices as L
 from trackbench.model.vehicle.parameters import pivots, total_mass
 from trackbench.scenario import Scenario
 from trackbench.vehicles import catalogue, read
@@ -121,6 +122,46 @@ def _return_run_sag(st, sc):
     return float(max(0.0, np.max(chord - run[:, 1])))
 
 
+def rest_angles(eq):
+    """Each arm's angle at rest, degrees below the chassis x axis (as vehicle.arm_angle)."""
+    nw = eq.wheel_load.size
+    return np.degrees(eq.q[L.Q_ARM:L.Q_ARM + nw] + math.pi)
+
+
+def _arm_notes(sc, eq, rest):
+    """Where the arms rest: set (arm_angle), or where the torsion bars from their free angles
+    carry the wheels, against the design position; and any arm resting on a bump stop."""
+    v = sc["vehicle"]
+    lines = []
+    if v.get("torsion_free_angle") is not None:
+        design = np.broadcast_to(np.asarray(v["arm_angle"], float), rest.shape)
+        la = np.broadcast_to(np.asarray(v["arm_length"], float), rest.shape)
+        rise = la * (np.sin(np.radians(design)) - np.sin(np.radians(rest)))
+        lines.append(
+            f"arms at rest where the torsion bars carry the wheels (free angle "
+            f"{_listed(v['torsion_free_angle'])} deg): {rest.min():.2f} to {rest.max():.2f} deg below the "
+            f"hull's x axis, the design position {_listed(v['arm_angle'])} deg; the wheels "
+            f"{1e3 * rise.min():.1f} to {1e3 * rise.max():.1f} mm higher on the hull"
+        )
+    for key, side in (("jounce_stop_angle", "jounce"), ("rebound_stop_angle", "rebound")):
+        if v.get(key) is None or not np.any(np.asarray(v.get("bump_stop_stiffness") or 0.0) > 0.0):
+            continue
+        stop = np.broadcast_to(np.asarray(v[key], float), rest.shape)
+        past = np.flatnonzero(rest < stop if side == "jounce" else rest > stop)
+        for i in past:
+            lines.append(
+                f"wheel {i + 1} rests on its {side} stop ({rest[i]:.2f} deg, the stop {stop[i]:.2f} deg)"
+            )
+    return lines
+
+
+def _listed(value):
+    """One number, or a per-wheel list shortened to its first value and '...'."""
+    if isinstance(value, (list, tuple)):
+        return f"{value[0]:g}" if len(set(value)) == 1 else f"{value[0]:g}, ..."
+    return f"{value:g}"
+
+
 def describe(st):
     """The text `trackbench vehicle show` prints."""
     sc, eq = st.scenario, st.eq
@@ -131,13 +172,17 @@ def describe(st):
         f"at rest on level ground: mass centre {eq.chassis_height:.4f} m high, pitch "
         f"{math.degrees(st.pitch):+.3f} deg (nose up +); residual {eq.residual / eq.weight:.1e} "
         "of the weight",
-        f"{'wheel':>5s} {'load kN':>9s} {'share':>7s} {'torsion N m':>12s} {'centre x, y (m)':>18s}",
+        f"{'wheel':>5s} {'load kN':>9s} {'share':>7s} {'arm deg':>8s} {'torsion N m':>12s} "
+        f"{'centre x, y (m)':>18s}",
     ]
     carried = float(np.sum(eq.wheel_load))
-    for i, (load, tq, (x, y)) in enumerate(zip(eq.wheel_load, eq.preload, st.wheels)):
+    rest = rest_angles(eq)
+    for i, (load, a, tq, (x, y)) in enumerate(zip(eq.wheel_load, rest, eq.preload, st.wheels)):
         lines.append(
-            f"{i + 1:5d} {load / 1e3:9.2f} {100 * load / carried:6.1f}% {tq:12.0f} {x:9.3f}, {y:.3f}"
+            f"{i + 1:5d} {load / 1e3:9.2f} {100 * load / carried:6.1f}% {a:8.2f} {tq:12.0f} "
+            f"{x:9.3f}, {y:.3f}"
         )
+    lines += _arm_notes(sc, eq, rest)
     lines.append(
         f"the ground carries {eq.ground_force / 1e3:.2f} kN, the weight {eq.weight / 1e3:.2f} kN "
         f"({eq.weight / g / 1e3:.3f} t); the wheels {carried / 1e3:.2f} kN (the weight and the "

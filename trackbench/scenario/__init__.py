@@ -22,7 +22,7 @@ from .check_closed import check_closed  # noqa: E402
 from .check_run import apply_preset, apply_sampling, check_extensions, check_sampling, check_solver  # noqa: E402
 from .check_terrain import check_placed_by_time, validate_terrain  # noqa: E402
 from .check_values import check_value, dotted_keys, flatten, merge, set_dotted, unknown  # noqa: E402
-from .check_vehicle import check_geometry  # noqa: E402
+from .check_vehicle import check_arm_stops, check_geometry  # noqa: E402
 from .parameters_table import (  # noqa: E402
     METHODS,
     OBSTACLE_KINDS,
@@ -135,6 +135,7 @@ def validate(d: Mapping[str, Any], explicit: frozenset[str] = frozenset()) -> di
             continue   # one per wheel: checked once the wheel count is
         set_dotted(out, name, check_value(name, value, RULES[name], name in OPEN_LOW))
     per_wheel_lists(out)
+    check_arm_stops(out["vehicle"])
     check_solver(out)
     out["terrain"] = validate_terrain(d["terrain"])
     check_sampling(out)

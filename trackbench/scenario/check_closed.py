@@ -51,6 +51,11 @@ def check_closed(out, explicit):
     # rolling loop crosses the paper's switches at the pin-passing frequency, and at a
     # switch a static equilibrium may not exist (docs/model.md)
     resolved = {**g.resolved(), "drive.target": out["speed"], "contact.geometry": "continuous"}
+    if out["vehicle"].get("torsion_free_angle") is not None:
+        # the arms rest where the torsion bars carry the wheels, found with the equilibrium: the
+        # preload that holds the loop at track.tension is derived round the wheels there
+        # (run/assemble.resting_vehicle), not round arm_angle, the design position
+        del resolved["idler.preload"]
     for name, value in resolved.items():
         if name not in explicit:
             set_dotted(out, name, value)

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ..model.vehicle.parameters import per_wheel, wheel_centres_with
+from ..model.vehicle.parameters import per_wheel, per_wheel_or_none, wheel_centres_with
 from . import ScenarioError
 
 
@@ -121,3 +121,31 @@ def _taut_length(ends, wc, rho):
     circ = [c + r * ring for c, r in zip(wc, np.broadcast_to(rho, (len(wc),)))]
     hull = _lower_hull(np.vstack([ends] + circ))
     return float(np.hypot(*np.diff(hull, axis=0).T).sum())
+
+
+def check_arm_stops(v):
+    """The bump stops around the arms' rest angle (arm_angle: with torsion_free_angle, the design
+    position): jounce stop < arm_angle < rebound stop, wheel by wheel, where stops are given;
+    a stop stiffness needs a stop angle."""
+    rest = per_wheel(v, "arm_angle")
+    jounce = per_wheel_or_none(v, "jounce_stop_angle")
+    rebound = per_wheel_or_none(v, "rebound_stop_angle")
+    k = per_wheel_or_none(v, "bump_stop_stiffness")
+    if k is not None and np.any(k > 0.0) and jounce is None and rebound is None:
+        raise ScenarioError(
+            "vehicle.bump_stop_stiffness is set but no stop: allowed: vehicle.jounce_stop_angle and/or "
+            "rebound_stop_angle (deg below the chassis x axis, as arm_angle), or no bump_stop_stiffness"
+        )
+    for i in range(len(rest)):
+        if jounce is not None and not jounce[i] < rest[i]:
+            raise ScenarioError(
+                f"vehicle.jounce_stop_angle = {jounce[i]:g} deg (wheel {i + 1}) must lie below "
+                f"vehicle.arm_angle = {rest[i]:g} deg: jounce lifts the wheel, a smaller angle below the "
+                "chassis x axis; allowed: jounce_stop_angle < arm_angle < rebound_stop_angle"
+            )
+        if rebound is not None and not rest[i] < rebound[i]:
+            raise ScenarioError(
+                f"vehicle.rebound_stop_angle = {rebound[i]:g} deg (wheel {i + 1}) must lie above "
+                f"vehicle.arm_angle = {rest[i]:g} deg: rebound drops the wheel, a larger angle below the "
+                "chassis x axis; allowed: jounce_stop_angle < arm_angle < rebound_stop_angle"
+            )

@@ -327,6 +327,19 @@ RULES["tolerance_pin_velocity"] = (
 )
 OPEN_LOW.add("tolerance_pin_velocity")
 
+# --- the road arms' bump stops and the torsion bars' free angle (model/vehicle/parameters.py
+# ARM_OPTIONS): optional, per wheel; angles below the chassis x axis as vehicle.arm_angle ----
+_ARM_ANGLE = (float, -90.0, 180.0, "a number in (-90, 180] deg (below the chassis x axis, as arm_angle)")
+RULES["vehicle.jounce_stop_angle"] = _ARM_ANGLE
+RULES["vehicle.rebound_stop_angle"] = _ARM_ANGLE
+RULES["vehicle.torsion_free_angle"] = _ARM_ANGLE
+RULES["vehicle.bump_stop_stiffness"] = (float, 0.0, 1e12, "a number in [0, 1e12] (N m/rad; 0: no bump stops)")
+OPTIONAL += ("vehicle.jounce_stop_angle", "vehicle.rebound_stop_angle", "vehicle.bump_stop_stiffness",
+             "vehicle.torsion_free_angle")
+OPEN_LOW.update({"vehicle.jounce_stop_angle", "vehicle.rebound_stop_angle", "vehicle.torsion_free_angle"})
+UNITS.update({"vehicle.jounce_stop_angle": "deg", "vehicle.rebound_stop_angle": "deg",
+              "vehicle.torsion_free_angle": "deg", "vehicle.bump_stop_stiffness": "N m/rad"})
+
 
 def parameter_names():
     """Every dotted name a scenario accepts (terrain keys included)."""

@@ -12,7 +12,7 @@ from trackbench.vehicles import VehicleError, read
 
 from . import ScenarioError
 from .check_values import flatten, set_dotted
-from .parameters_table import PER_WHEEL_NAMES, VEHICLE_GROUPS, paper_step
+from .parameters_table import OPTIONAL, PER_WHEEL_NAMES, VEHICLE_GROUPS, paper_step
 
 
 def take_model(nested):
@@ -24,9 +24,12 @@ def take_model(nested):
 
 
 def vehicle_defaults():
-    """{dotted name: the paper's value} of every name a vehicle file may set."""
+    """{dotted name: the paper's value} of every name a vehicle file may set (an optional one,
+    parameters_table.OPTIONAL: None, the paper has none)."""
     d = paper_step()
-    return flatten({g: d[g] for g in VEHICLE_GROUPS})
+    out = flatten({g: d[g] for g in VEHICLE_GROUPS})
+    out.update({name: None for name in OPTIONAL if name.split(".", 1)[0] in VEHICLE_GROUPS})
+    return out
 
 
 def apply_model(d, model, explicit, folder=None):
@@ -36,7 +39,7 @@ def apply_model(d, model, explicit, folder=None):
     (a resolved one: a study's resolved copy, a run's scenario) keeps the name as a label and
     reads no file."""
     defaults = vehicle_defaults()
-    if all(name in explicit for name in defaults):
+    if all(name in explicit for name, default in defaults.items() if default is not None):
         d["vehicle"]["model"] = model
         return frozenset()
     try:
@@ -45,7 +48,7 @@ def apply_model(d, model, explicit, folder=None):
         raise ScenarioError(str(e)) from None
     _check_alone(vf)
     for name, default in defaults.items():
-        if name not in explicit:
+        if name not in explicit and (default is not None or name in vf.values):   # optional: only given
             set_dotted(d, name, copy.deepcopy(vf.values.get(name, default)))
     d["vehicle"]["model"] = model
     return frozenset(n for n, v in vf.values.items() if v != defaults[n])
@@ -85,7 +88,7 @@ def per_wheel_lists(out):
     n = out["vehicle"]["n_wheels"]
     for name in PER_WHEEL_NAMES:
         key = name.split(".", 1)[1]
-        value = out["vehicle"][key]
+        value = out["vehicle"].get(key)   # an optional one (parameters.ARM_OPTIONS) may be absent
         if not isinstance(value, (list, tuple)):
             continue
         want = n - 1 if key == "pivot_spacing" else n

@@ -327,7 +327,12 @@ ARMS_INERTIA = 7         # about the wheel centre (kg m^2)
 ARMS_STIFFNESS = 8       # torsion bar k_t (N m/rad)
 ARMS_DIAGONAL = 9        # the arm's diagonal mass about its pivot, m l^2 + I (kg m^2)
 ARMS_RADIUS = 10         # wheel radius (m)
-N_ARMS_COLS = 11
+# bump stops (vehicle.bump_stop_stiffness; 0: none, the paper): beyond a stop angle the arm
+# gets -k_stop (phi - phi_stop); jounce (the wheel up) is phi below ARMS_JOUNCE, rebound above
+ARMS_STOP_K = 11         # k_stop (N m/rad)
+ARMS_JOUNCE = 12         # phi of the jounce stop (rad; -inf: none)
+ARMS_REBOUND = 13        # phi of the rebound stop (rad; +inf: none)
+N_ARMS_COLS = 14
 
 # --- per-evaluation diagnostics, ``diag`` -------------------------------------------
 D_STATUS = 0             # 0 ok, else a Status code found in this evaluation

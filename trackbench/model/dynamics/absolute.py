@@ -15,7 +15,8 @@ rows 2i, 2i+1 of Phi):
 with p_i the pivot body point. Eq. (9): M zdd = F(z) - Phi_q^T lambda, so lambda_i is
 the force the chassis exerts on arm i at its pivot (the chassis gets -lambda_i there).
 F holds gravity, torsion bars (torque -k_t (beta_i - theta - phi0_i) on arm i, the
-reaction on the chassis), track tension and contact forces from ``track_loads.track_loads``
+reaction on the chassis; the bump stops' -k_stop x excess beyond a stop likewise), track
+tension and contact forces from ``track_loads.track_loads``
 (pins 0 and n_links ride on the chassis at the track-end body points). There are no
 velocity-dependent forces, so Eq. (9) has the form z'' = f(z, lambda) an RKN method
 integrates. Phi_q is never formed: the products are evaluated directly from the
@@ -29,12 +30,15 @@ from numba import njit
 from ..core import fixed_math as fm
 from ..core.indices import (
     ARMS_INERTIA,
+    ARMS_JOUNCE,
     ARMS_LENGTH,
     ARMS_MASS,
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    ARMS_REBOUND,
     ARMS_STIFFNESS,
+    ARMS_STOP_K,
     D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
@@ -72,6 +76,7 @@ from ..core.indices import (
 from ..core.indices_jit import diag_tension, nq_of, pin_offset, z_arm, z_pin
 from ..core.jit import BORROW, INLINE
 from ..vehicle.kinematics import body_offset, wheel_offset
+from .reduced import stop_excess
 from .track_loads import track_loads
 
 
@@ -292,6 +297,9 @@ def applied_forces(z, zd, m, w, F, fc, diag):
     for i in range(nw):
         j = z_arm(i)
         tors = -arms[i, ARMS_STIFFNESS] * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0])
+        if arms[i, ARMS_STOP_K] != 0.0:   # bump stops (reduced.chassis_and_arms)
+            tors -= arms[i, ARMS_STOP_K] * stop_excess(z[j + ZA_BETA] - z[Z_PITCH], arms[i, ARMS_JOUNCE],
+                                                       arms[i, ARMS_REBOUND])
         tq -= tors
         F[j + ZA_X] = fwheel[i, 0]
         F[j + ZA_Y] = fwheel[i, 1] - arms[i, ARMS_MASS] * g
@@ -342,6 +350,9 @@ def finish_diag(z, zd, zdd, par, arms, power, diag):
                + 0.5 * arms[i, ARMS_INERTIA] * zd[j + ZA_BETA] ** 2)
         eg += arms[i, ARMS_MASS] * g * z[j + ZA_Y]
         et += 0.5 * arms[i, ARMS_STIFFNESS] * (z[j + ZA_BETA] - z[Z_PITCH] - arms[i, ARMS_PHI0]) ** 2
+        if arms[i, ARMS_STOP_K] != 0.0:
+            ex = stop_excess(z[j + ZA_BETA] - z[Z_PITCH], arms[i, ARMS_JOUNCE], arms[i, ARMS_REBOUND])
+            et += 0.5 * arms[i, ARMS_STOP_K] * ex * ex
     mp = par[P_PIN_MASS]
     for k in range(nb, z.shape[0], 2):
         ke += 0.5 * mp * (zd[k] ** 2 + zd[k + 1] ** 2)

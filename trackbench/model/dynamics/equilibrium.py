@@ -6,6 +6,14 @@ Every arm is held at the equilibrium arm angle; unknowns are the chassis height 
 pitch and the free pins. The torsion-bar free angles phi0_i (the preloads) follow from
 each arm's moment balance about its pivot, so they are eliminated from the Newton
 iteration and computed afterwards.
+
+Where the vehicle gives the free angles (vehicle.torsion_free_angle) the arm angles are
+Newton unknowns as well, after the others, and each arm's moment balance (torsion bar and
+bump stops included) an equation. Why not a fixed-point iteration (rest angle <- free angle
++ arm moment / k_t around the held solve): with the arms held, a wheel's load follows its
+angle through the pads' stiffness (about 1e8 N/m, a moment of ~1e7 N m/rad at the pivot),
+hundreds of times the torsion bar's k_t, so that iteration diverges; Newton's method takes
+the coupling from its Jacobian.
 """
 
 
@@ -18,13 +26,25 @@ from ..core.bundles import arm_table, model_arrays, work_arrays
 from ..core.indices_jit import n_coordinates, pin_offset, q_idler, q_sprocket
 from ..core.jit import KERNEL
 from ..ground.terrain import flat_ground
-from ..vehicle.parameters import equilibrium_arm_angle, pack, station_columns, total_mass
+from ..vehicle.parameters import equilibrium_arm_angle, free_angle, pack, station_columns, total_mass
 from .closed_track_jit import closed_rhs
+from .reduced import stop_excess
 from .rhs import rhs
 
 
+def _arms_at_rest(problem, vehicle, track, piv):
+    """The problem's arm angles (held, or the free arms' first guess), whether the arms are
+    free, and its arm table: the torsion bars' free angles where the vehicle gives them, else
+    the held angles (no torsion torque: the preloads follow from the balance)."""
+    problem.phi = equilibrium_arm_angle(vehicle)   # one per arm
+    phi0 = free_angle(vehicle)
+    problem.free = phi0 is not None
+    problem.arms = arm_table(piv, phi0 if problem.free else problem.phi, 0.0, station_columns(vehicle, track))
+
+
 class StaticProblem:
-    """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins)."""
+    """Residual of the equilibrium equations in the unknowns u = (y_c, pitch, pins), and
+    the arm angles where they are free (self.free)."""
 
     def __init__(self, vehicle, track, gravity, contact=None, soil=None):
         self.par, piv, self.ends = pack(vehicle, track, gravity, contact)
@@ -32,8 +52,7 @@ class StaticProblem:
             self.par[k] = v
         self.nw = int(vehicle["n_wheels"])
         self.n_links = int(track["n_links"])
-        self.phi = equilibrium_arm_angle(vehicle)   # one per arm
-        self.arms = arm_table(piv, self.phi, 0.0, station_columns(vehicle, track))
+        _arms_at_rest(self, vehicle, track, piv)
         g = flat_ground()
         self.m = model_arrays(self.par, self.arms, self.ends, g.segments, g.corners, self.n_links,
                               rut=np.zeros(0) if soil else None)
@@ -42,16 +61,24 @@ class StaticProblem:
         self.nq = L.n_coordinates(self.nw, self.n_links)
         self.weight = total_mass(vehicle, track) * gravity
 
+    def arm_angles(self, u):
+        """The arms' angles at u: the free arms' unknowns (u's last nw), or the held angles."""
+        return u[u.size - self.nw:] if self.free else self.phi
+
+    def with_arms(self, u):
+        """u with the free arms' unknowns appended at their first guess (else u itself)."""
+        return np.concatenate([u, self.phi]) if self.free else u
+
     def q_of(self, u):
         q = np.zeros(self.nq)
         q[L.Q_Y] = u[0]
         q[L.Q_PITCH] = u[1]
-        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
-        q[L.pin_offset(self.nw):] = u[2:]
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.arm_angles(u)
+        q[L.pin_offset(self.nw):] = u[2:u.size - self.nw * self.free]
         return q
 
     def _args(self):
-        return self.phi, self.m, self.work, self.diag
+        return self.phi, self.m, self.work, self.diag, self.free
 
     def residual(self, u):
         """(vertical force, moment of chassis + arms, pin forces); horizontal force; arm moments."""
@@ -112,20 +139,26 @@ def _arms_mass(arms):
 
 
 @njit(**KERNEL)
-def _residual(u, phi, m, w, diag, r, arm_moment):
+def _residual(u, phi, m, w, diag, free, r, arm_moment):
     """Force balance of every free pin, vertical force and moment of chassis + arms
-    (into r), each arm's moment about its pivot (arm_moment); returns the horizontal force."""
+    (into r), each arm's moment about its pivot (arm_moment: the loads', torsion bar and
+    stops left out); free arms: their angles u's last nw, their balance r's last nw. Returns
+    the horizontal force."""
     apos, fpin, fwheel, wc = w.apos, w.fpin, w.fwheel, w.wc
     par, arms = m.par, m.arms
     nw = arms.shape[0]
     n = apos.shape[0] - 1
     nq = n_coordinates(nw, n)
+    n_free = nw if free else 0
     q = np.zeros(nq)
     q[L.Q_Y] = u[0]
     q[L.Q_PITCH] = u[1]
     for i in range(nw):
-        q[L.Q_ARM + i] = phi[i]  # every arm at its equilibrium angle
-    for k in range(2, u.shape[0]):
+        if free:
+            q[L.Q_ARM + i] = u[u.shape[0] - nw + i]
+        else:
+            q[L.Q_ARM + i] = phi[i]  # every arm at its equilibrium angle
+    for k in range(2, u.shape[0] - n_free):
         q[L.Q_ARM + nw + k - 2] = u[k]
     _loads_at_rest(q, m, w, diag)
     s, c = fm.sincos(u[1])
@@ -149,6 +182,12 @@ def _residual(u, phi, m, w, diag, r, arm_moment):
     for b in range(1, n):
         r[2 * b] = fpin[b, 0]
         r[2 * b + 1] = fpin[b, 1] - par[L.P_PIN_MASS] * g
+    for i in range(n_free):   # the free arms' balance: loads, torsion bar, bump stops
+        a = q[L.Q_ARM + i]
+        tq = arm_moment[i] - arms[i, L.ARMS_STIFFNESS] * (a - arms[i, L.ARMS_PHI0])
+        if arms[i, L.ARMS_STOP_K] != 0.0:
+            tq -= arms[i, L.ARMS_STOP_K] * stop_excess(a, arms[i, L.ARMS_JOUNCE], arms[i, L.ARMS_REBOUND])
+        r[u.shape[0] - nw + i] = tq
     return fx
 
 
@@ -168,8 +207,7 @@ class ClosedStaticProblem(StaticProblem):
             self.par[k] = v
         self.nw = int(vehicle["n_wheels"])
         self.n_links = geometry.n_links
-        self.phi = equilibrium_arm_angle(vehicle)
-        self.arms = arm_table(piv, self.phi, 0.0, station_columns(vehicle, track))
+        _arms_at_rest(self, vehicle, track, piv)
         g = flat_ground()
         self.m = model_arrays(
             self.par,
@@ -193,14 +231,14 @@ class ClosedStaticProblem(StaticProblem):
         q = np.zeros(self.nq)
         q[L.Q_Y] = u[0]
         q[L.Q_PITCH] = u[1]
-        q[L.Q_ARM:L.Q_ARM + self.nw] = self.phi
+        q[L.Q_ARM:L.Q_ARM + self.nw] = self.arm_angles(u)
         q[L.q_idler(self.nw, self.n_links)] = u[2]
         q[L.q_sprocket(self.nw, self.n_links)] = u[3]
-        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[4:]
+        q[L.pin_offset(self.nw):L.pin_offset(self.nw) + 2 * self.n_links] = u[4:4 + 2 * self.n_links]
         return q
 
     def _args(self):
-        return self.phi, self.psi, self.m, self.work, self.diag
+        return self.phi, self.psi, self.m, self.work, self.diag, self.free
 
     def residual(self, u):
         r = np.empty(u.size)
@@ -215,7 +253,7 @@ class ClosedStaticProblem(StaticProblem):
 
 
 @njit(**KERNEL)
-def _closed_jacobian(u, h, phi, psi, m, w, diag, J):
+def _closed_jacobian(u, h, phi, psi, m, w, diag, free, J):
     """Central finite differences of _closed_residual (compiled: ~270 residuals a step)."""
     n = u.shape[0]
     rp = np.empty(n)
@@ -224,9 +262,9 @@ def _closed_jacobian(u, h, phi, psi, m, w, diag, J):
     up = u.copy()
     for k in range(n):
         up[k] = u[k] + h
-        _closed_residual(up, phi, psi, m, w, diag, rp, am)
+        _closed_residual(up, phi, psi, m, w, diag, free, rp, am)
         up[k] = u[k] - h
-        _closed_residual(up, phi, psi, m, w, diag, rm, am)
+        _closed_residual(up, phi, psi, m, w, diag, free, rm, am)
         up[k] = u[k]
         for i in range(n):
             v = (rp[i] - rm[i]) / (2.0 * h)
@@ -234,17 +272,21 @@ def _closed_jacobian(u, h, phi, psi, m, w, diag, J):
 
 
 @njit(**KERNEL)
-def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
+def _closed_residual(u, phi, psi, m, w, diag, free, r, arm_moment):
     """The closed layout's generalised forces at rest (closed_track_jit.closed_rhs fills w.genf) on the
     unknowns into r (on the sprocket angle: its change, which holds it), each arm's moment
-    about its pivot; returns the horizontal force."""
+    about its pivot (held arms: the loads'; free arms, u's and r's last nw: the balance, torsion
+    bar and stops included); returns the horizontal force."""
     nw = m.arms.shape[0]
     n = w.apos.shape[0] - 1
     y = np.zeros(m.pins[L.PN_NY])   # at rest: every bristle's deflection 0
     y[L.Q_Y] = u[0]
     y[L.Q_PITCH] = u[1]
     for i in range(nw):
-        y[L.Q_ARM + i] = phi[i]
+        if free:
+            y[L.Q_ARM + i] = u[4 + 2 * n + i]
+        else:
+            y[L.Q_ARM + i] = phi[i]
     y[q_idler(nw, n)] = u[2]
     y[q_sprocket(nw, n)] = u[3]
     off = pin_offset(nw)
@@ -260,6 +302,8 @@ def _closed_residual(u, phi, psi, m, w, diag, r, arm_moment):
         r[4 + k] = w.genf[off + k]
     for i in range(nw):
         arm_moment[i] = w.genf[L.Q_ARM + i]
+        if free:
+            r[4 + 2 * n + i] = w.genf[L.Q_ARM + i]
     return w.genf[L.Q_X]
 
 

@@ -17,12 +17,15 @@ from ..core.indices import (
     ARMS_DAMPING,
     ARMS_DIAGONAL,
     ARMS_INERTIA,
+    ARMS_JOUNCE,
     ARMS_LENGTH,
     ARMS_MASS,
     ARMS_PHI0,
     ARMS_PX,
     ARMS_PY,
+    ARMS_REBOUND,
     ARMS_STIFFNESS,
+    ARMS_STOP_K,
     D_CHASSIS_ALPHA,
     D_CHASSIS_AX,
     D_CHASSIS_AY,
@@ -45,7 +48,7 @@ from ..core.indices import (
     Y_WORK,
 )
 from ..core.indices_jit import q_pin
-from ..core.jit import BORROW, INLINE
+from ..core.jit import BORROW, INLINE, SCALAR
 from ..ground.grip import bristle_rates, start_bristles, uses_bristle
 from ..vehicle.kinematics import body_offset, positions
 from .track_loads import track_loads
@@ -65,11 +68,23 @@ def _track_ends(q, par, apos, fpin):
     return qx, qy, qt
 
 
+@njit(**SCALAR)
+def stop_excess(phi, jounce, rebound):
+    """How far arm angle phi lies beyond its bump stops (rad): phi - jounce below the jounce
+    stop (the wheel up), phi - rebound above the rebound stop, else 0. The stop's torque on
+    the arm is -k_stop times it, its energy 0.5 k_stop times its square."""
+    if phi < jounce:
+        return phi - jounce
+    if phi > rebound:
+        return phi - rebound
+    return 0.0
+
+
 @njit(**INLINE)
 def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
     """Chassis block A (3x3, symmetric) and generalised force on (x, y, pitch), starting
     from f0 (what acts on the chassis itself), every arm + road wheel added; the coupling
-    B_i of each arm and its generalised force (torsion bar included) into w.arm. Returns
+    B_i of each arm and its generalised force (torsion bar and bump stops included) into w.arm. Returns
     (A, f, (kinetic, torsion, gravity energies), power dissipated by the shock absorbers)."""
     mc = par[P_CHASSIS_MASS]
     g = par[P_GRAVITY]
@@ -123,6 +138,12 @@ def chassis_and_arms(q, qd, par, arms, fwheel, wv, wc, arm, c, s, f0):
             dissipation += arms[i, ARMS_DAMPING] * qd[Q_ARM + i] ** 2
         ke += 0.5 * ma * (wv[i, 0] ** 2 + wv[i, 1] ** 2) + 0.5 * ia * wb * wb
         e_tors += 0.5 * kt * (q[Q_ARM + i] - arms[i, ARMS_PHI0]) ** 2
+        if arms[i, ARMS_STOP_K] != 0.0:
+            # bump stops: a stiff torsion spring beyond each stop angle, its energy with the
+            # torsion bars' (skipped without stops: the paper's arm, bit for bit)
+            ex = stop_excess(q[Q_ARM + i], arms[i, ARMS_JOUNCE], arms[i, ARMS_REBOUND])
+            arm[i, ARM_Q] -= arms[i, ARMS_STOP_K] * ex
+            e_tors += 0.5 * arms[i, ARMS_STOP_K] * ex * ex
         e_grav += ma * g * wc[i, 1]
     return (a00, a01, a02, a11, a12, a22), (qx, qy, qt), (ke, e_tors, e_grav), dissipation
 

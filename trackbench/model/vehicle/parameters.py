@@ -132,7 +132,12 @@ NEIGHBOUR_SKIN = 0.05  # m; only sets how often the contact lists are rebuilt
 # the vehicle's values that may differ from road wheel to road wheel: a list (one per wheel,
 # front to rear; pivot_spacing one per gap between neighbours) or one number for every wheel
 PER_WHEEL = ("arm_mass", "arm_inertia", "arm_length", "arm_angle", "torsion_stiffness", "wheel_radius",
-             "pivot_y", "pivot_spacing")
+             "pivot_y", "pivot_spacing") + ("jounce_stop_angle", "rebound_stop_angle", "bump_stop_stiffness",
+                                             "torsion_free_angle")
+# the optional ones among them (no default, absent from the paper's vehicle: a vehicle without
+# them resolves, hashes and runs as before): the road arms' bump stops and the torsion bars'
+# free angle, the ride height (docs/model.md, "Bump stops" and "Initial equilibrium")
+ARM_OPTIONS = ("jounce_stop_angle", "rebound_stop_angle", "bump_stop_stiffness", "torsion_free_angle")
 
 
 def per_wheel(vehicle, key):
@@ -156,10 +161,47 @@ def pivots(vehicle):
     return np.column_stack([x, per_wheel(vehicle, "pivot_y")])
 
 
+def per_wheel_or_none(vehicle, key):
+    """per_wheel of an optional key (ARM_OPTIONS), None where the vehicle does not give it."""
+    return None if vehicle.get(key) is None else per_wheel(vehicle, key)
+
+
+def arm_phi(angle_deg):
+    """phi of arms at these angles below the chassis x axis (deg), trailing: -pi + angle."""
+    return np.array([-math.pi + math.radians(a) for a in angle_deg])
+
+
 def equilibrium_arm_angle(vehicle):
     """phi of each arm at the initial equilibrium (one per wheel): trailing arm, arm_angle
-    below the chassis x axis."""
-    return np.array([-math.pi + math.radians(a) for a in per_wheel(vehicle, "arm_angle")])
+    below the chassis x axis. With vehicle.torsion_free_angle, arm_angle is the design position
+    and the equilibrium's first guess, until with_rest_angles puts the solved rest angles there."""
+    return arm_phi(per_wheel(vehicle, "arm_angle"))
+
+
+def free_angle(vehicle):
+    """phi of each torsion bar's free angle (vehicle.torsion_free_angle), or None: then the
+    arms rest at arm_angle and the free angles follow from the equilibrium."""
+    a = per_wheel_or_none(vehicle, "torsion_free_angle")
+    return None if a is None else arm_phi(a)
+
+
+def with_rest_angles(vehicle, phi):
+    """A copy of vehicle whose arm_angle holds the rest angles phi (one per arm): the wheels at
+    rest that the closed track's geometry and the equilibrium's start are built round."""
+    return {**vehicle, "arm_angle": [math.degrees(p + math.pi) for p in phi]}
+
+
+def stop_columns(vehicle):
+    """{ARMS_* column: values} of the bump stops: k_stop and the stops' phi (jounce: the wheel
+    up, a smaller angle below the x axis; a stop not given: -inf or +inf, never reached); k_stop
+    0 where the vehicle gives none (the kernels then skip the stops: the paper's model)."""
+    n = int(vehicle["n_wheels"])
+    k = per_wheel_or_none(vehicle, "bump_stop_stiffness")
+    jounce = per_wheel_or_none(vehicle, "jounce_stop_angle")
+    rebound = per_wheel_or_none(vehicle, "rebound_stop_angle")
+    return {L.ARMS_STOP_K: np.zeros(n) if k is None else k,
+            L.ARMS_JOUNCE: np.full(n, -math.inf) if jounce is None else arm_phi(jounce),
+            L.ARMS_REBOUND: np.full(n, math.inf) if rebound is None else arm_phi(rebound)}
 
 
 def wheel_centres_body(vehicle):
@@ -183,7 +225,7 @@ def station_columns(vehicle, track):
     r = per_wheel(vehicle, "wheel_radius")
     return {L.ARMS_LENGTH: la, L.ARMS_REACH: r + track["pad_wheel"], L.ARMS_MASS: ma, L.ARMS_INERTIA: ia,
             L.ARMS_STIFFNESS: per_wheel(vehicle, "torsion_stiffness"), L.ARMS_DIAGONAL: ma * la * la + ia,
-            L.ARMS_RADIUS: r}
+            L.ARMS_RADIUS: r, **stop_columns(vehicle)}
 
 
 def _pack_contact(par, contact):

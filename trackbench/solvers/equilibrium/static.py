@@ -16,7 +16,7 @@ from .continuation import soil_sinkage_guess, solve_static
 @dataclass
 class Equilibrium:
     q: np.ndarray  # reduced coordinates (model/core/indices.py), chassis x = 0
-    phi0: np.ndarray  # torsion-bar free angles (rad)
+    phi0: np.ndarray  # torsion-bar free angles (rad; given by vehicle.torsion_free_angle, or solved)
     preload: np.ndarray  # torsion-bar torque on each arm at equilibrium (N m)
     wheel_load: np.ndarray  # vertical track force on each road wheel (N)
     tension: np.ndarray  # per link (N)
@@ -59,8 +59,13 @@ def _balance(P, u, it, first_pin=0):
     wheel loads, wheel centres and link tensions."""
     r, fx, arm_moment = P.residual(u)
     q = P.q_of(u)
-    preload = -arm_moment
-    phi0 = q[L.Q_ARM : L.Q_ARM + P.nw] + preload / P.arms[:, L.ARMS_STIFFNESS]
+    phi = q[L.Q_ARM : L.Q_ARM + P.nw]
+    if P.free:   # the free angles given, the rest angles solved: the torsion bars' torque there
+        phi0 = P.arms[:, L.ARMS_PHI0].copy()
+        preload = -P.arms[:, L.ARMS_STIFFNESS] * (phi - phi0)
+    else:
+        preload = -arm_moment
+        phi0 = phi + preload / P.arms[:, L.ARMS_STIFFNESS]
     apos, fpin, fwheel, wc = P.loads(q)
     tension = P.diag[L.diag_tension(P.nw) : L.diag_tension(P.nw) + P.n_links].copy()
     return Equilibrium(
@@ -93,6 +98,7 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
     u = np.concatenate([[yc, 0.0], pins[1:-1].ravel()])
     u[0] -= soil_sinkage_guess(P, pins)
     u[3::2] -= soil_sinkage_guess(P, pins)
+    u = P.with_arms(u)
     u, it = solve_static(
         P, u, max_iter, tol_rel, "static equilibrium not found", "the vehicle and track geometry"
     )
@@ -100,15 +106,24 @@ def solve_equilibrium(vehicle, track, gravity, contact=None, soil=None, tol_rel=
 
 
 def solve_closed_equilibrium(
-    vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12, max_iter=60
+    vehicle, track, gravity, contact, geometry, loop, guides, soil=None, tol_rel=1e-12, max_iter=60,
+    start=None,
 ):
     """Static equilibrium of the closed layout on flat ground: Newton's method from the
-    taut loop (model/vehicle/closed_track.py) resting on the ground, the sprocket held."""
+    taut loop (model/vehicle/closed_track.py) resting on the ground, the sprocket held; or from
+    start, another equilibrium of the same vehicle and loop (its unknowns; the sprocket held
+    where it was), the arms at its angles."""
     P = ClosedStaticProblem(vehicle, track, gravity, contact, geometry, loop, guides, soil)
-    yc = (
-        -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND] - soil_sinkage_guess(P, P.pins)
-    )  # lowest pins on the ground
-    u = np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()])
+    if start is None:
+        yc = (
+            -P.pins[:, 1].min() + P.par[L.P_PAD_GROUND] - soil_sinkage_guess(P, P.pins)
+        )  # lowest pins on the ground
+        u = P.with_arms(np.concatenate([[yc, 0.0, P.slide0, P.psi], (P.pins + [0.0, yc]).ravel()]))
+    else:
+        n = 4 + 2 * P.n_links
+        u = np.concatenate([start.info["unknowns"][:n], start.q[L.Q_ARM:L.Q_ARM + P.nw]]) if P.free else \
+            start.info["unknowns"][:n].copy()
+        P.psi = u[3]
     u, it = solve_static(
         P,
         u,
@@ -125,6 +140,7 @@ def solve_closed_equilibrium(
             "idler_force": float(P.diag[L.D_IDLER_FORCE]),
             "holding_torque": float(w.spr[L.SP_TORQUE]),  # forward drive torque that holds the sprocket
             "guide_forces": w.fguide.copy(),
+            "unknowns": u.copy(),   # a start for another solve (start)
         }
     )
     return eq
