@@ -57,6 +57,7 @@ import numpy as np
 
 import trackbench as tb
 from trackbench.outputs import quantities
+from trackbench.solvers import registry
 
 REFERENCE = {"method": "dopri5", "tolerance": 1e-11}
 TOLERANCES = (1e-7, 1e-8, 1e-9)
@@ -78,7 +79,7 @@ def default_methods(solver="reduced"):
 
 
 # the methods whose error norm holds the pins' velocities to tolerance_pin_velocity
-PIN_METHODS = ("ros34pw2",)
+PIN_METHODS = registry.pin_tolerance_methods()
 
 
 def variants(methods=None, tolerances=TOLERANCES, pin_ratios=(1.0,)):
