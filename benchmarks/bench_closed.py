@@ -3,8 +3,10 @@ Prints figures; asserts nothing. Takes several minutes.
 
     python benchmarks/bench_closed.py            # everything
     python benchmarks/bench_closed.py drive      # one part: rest, drive, profiles, traction, step, cost,
-                                                 # ratios, precision, spread, criterion
+                                                 # ratios, precision, spread, criterion, energy
     python benchmarks/bench_closed.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
+    python benchmarks/bench_closed.py energy --methods ros34pw2,dopri5 --tolerances 1e-5,1e-6,1e-7 \
+        --pin-ratios 1,10
 """
 
 import sys

@@ -5,6 +5,11 @@ far its figures land from a tight reference run. Used by bench_closed.py and ben
     python benchmarks/bench_closed.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
     python benchmarks/bench_closed.py spread --methods dopri5 --tolerances 1e-8
     python benchmarks/bench_soil.py precision spread --repeats 1
+    python benchmarks/bench_closed.py energy --methods ros34pw2,dopri5 --tolerances 1e-5,1e-6,1e-7 \
+        --pin-ratios 1,10
+
+energy: the work-based energy residual (over the accepted steps, over the samples, at the end)
+beside the cost (wall / simulated time against the paper's model's in the same process).
 
 criterion: benchmarks/accuracy.py (the reference ensembles, each variant judged beside the
 paper's model). --pin-ratios 1,10 gives the methods that take tolerance_pin_velocity (PIN_METHODS)
@@ -57,6 +62,7 @@ import numpy as np
 
 import trackbench as tb
 from trackbench.outputs import quantities
+from trackbench.solvers import registry
 
 REFERENCE = {"method": "dopri5", "tolerance": 1e-11}
 TOLERANCES = (1e-7, 1e-8, 1e-9)
@@ -78,7 +84,7 @@ def default_methods(solver="reduced"):
 
 
 # the methods whose error norm holds the pins' velocities to tolerance_pin_velocity
-PIN_METHODS = ("ros34pw2",)
+PIN_METHODS = registry.pin_tolerance_methods()
 
 
 def variants(methods=None, tolerances=TOLERANCES, pin_ratios=(1.0,)):
@@ -338,6 +344,48 @@ def precision(name, model, vs, repeats=REPEATS):
     )
 
 
+def energy(name, model, vs, repeats=REPEATS, bar=1e-6):
+    """The work-based energy residual of each variant beside its cost: wall / simulated time,
+    best of `repeats` rounds alternating with the paper's model (paper_step at its defaults) in
+    this process, and the residual's largest |value| / E0 over the accepted steps (the run's
+    max_energy_residual), over the output samples (energy_residual: the dense output between
+    steps) and at the end, against `bar`."""
+    t0 = time.perf_counter()
+    print(f"\n### {name}: energy residual against cost (bar {bar:g} of E0)")
+    vs = _runnable(model, vs)
+    paper = tb.Scenario.paper()
+    scs = {None: paper, **{json.dumps(v, sort_keys=True): tb.Scenario.from_dict({**model, **v}) for v in vs}}
+    for sc in scs.values():
+        tb.simulate(sc.with_overrides({"duration": 0.02}))   # compiled and loaded first
+    best, fig = dict.fromkeys(scs, math.inf), {}
+    for _ in range(max(repeats, 1)):
+        for key, sc in scs.items():
+            t = time.perf_counter()
+            ds = tb.simulate(sc)
+            best[key] = min(best[key], time.perf_counter() - t)
+            if key is not None:
+                r = np.abs(ds.energy_residual.values)
+                fig[key] = (ds.attrs["steps"], ds.attrs["rejected_steps"], float(ds.max_energy_residual),
+                            float(np.nanmax(r)), float(ds.energy_residual.values[-1]))
+    base = best[None] / paper["duration"]
+    print(f"\nthe paper's model: {base:.3f} s wall / simulated s\n")
+    head = ("method", "tolerance", "pins' velocities", "wall / simulated", "/ the paper model's",
+            "steps (+ rejected)", "residual, steps", "samples", "end", f"<= {bar:g}")
+    print(_row(head))
+    print(_row(["---"] * len(head)))
+    for key, sc in scs.items():
+        if key is None:
+            continue
+        v = json.loads(key)
+        steps, rej, at_steps, at_samples, end = fig[key]
+        ratio = best[key] / sc["duration"]
+        pins = f"{v['tolerance_pin_velocity']:g}" if "tolerance_pin_velocity" in v else "-"
+        print(_row([v["method"], f"{v['tolerance']:g}", pins, f"{ratio:.3f}", f"{ratio / base:.1f}x",
+                    f"{steps:,} (+{rej:,})", f"{at_steps:.1e}", f"{at_samples:.1e}", f"{end:+.1e}",
+                    "met" if max(at_steps, at_samples) <= bar else "**not met**"]))
+    print(f"\nbest of {repeats} rounds; part took {time.perf_counter() - t0:.0f} s")
+
+
 def _spread(values):
     v = np.array(values, dtype=float)
     return float((v.max() - v.min()) / abs(v.mean())) if len(v) and v.mean() else math.nan
@@ -390,7 +438,7 @@ def spread(name, model, vs):
 def main(argv, parts, models):
     """Run a benchmark script's parts named on its command line; the "precision" and "spread"
     parts run precision() and spread() on each of `models` (name -> scenario overrides)."""
-    names, vs, repeats = command_line(argv, [*parts, "precision", "spread", "criterion"])
+    names, vs, repeats = command_line(argv, [*parts, "precision", "spread", "criterion", "energy"])
     for name in names:
         if name in parts:
             parts[name]()
@@ -399,6 +447,8 @@ def main(argv, parts, models):
                 precision(label, model, vs, repeats)
             elif name == "spread":
                 spread(label, model, vs)
+            elif name == "energy":
+                energy(label, model, vs, repeats)
             elif name == "criterion":
                 import accuracy
 

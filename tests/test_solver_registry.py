@@ -162,6 +162,29 @@ def test_validation_reads_the_entry(toys):
         tb.Scenario.from_dict({"solver": "relay", "method": "dop853"})
 
 
+def test_the_pins_tolerance_only_with_a_method_that_honours_it(toys, monkeypatch):
+    """tolerance_pin_velocity is refused, in one line naming it and the methods that honour it,
+    where the method ignores it; which methods honour it is their entry's pin_tolerance_methods."""
+    assert registry.pin_tolerance_methods() == ("ros34pw2",)
+    tb.Scenario.from_dict({"method": "ros34pw2", "tolerance_pin_velocity": 1e-5})
+    for over in ({}, {"method": "ark548l2sa"}, {"solver": "lee"}, {"solver": "relay"}):
+        with pytest.raises(tb.ScenarioError) as e:
+            tb.Scenario.from_dict({**over, "tolerance_pin_velocity": 1e-5})
+        text = str(e.value)
+        assert "\n" not in text
+        assert text.startswith("tolerance_pin_velocity is honoured only by method = 'ros34pw2'; "), text
+    assert "method 'lee-rkn' ignores it" in str(pytest.raises(
+        tb.ScenarioError, tb.Scenario.from_dict, {"solver": "lee", "tolerance_pin_velocity": 1e-5}).value)
+    honours = registry.SolverEntry("relay", "toy_relay", ("dopri5",), "a relay that honours it",
+                                   closed_track=True, extended_models=True, streams=True,
+                                   pin_tolerance_methods=("dopri5",))
+    monkeypatch.setitem(registry.SOLVERS, "relay", honours)
+    tb.Scenario.from_dict({"solver": "relay", "tolerance_pin_velocity": 1e-5})
+    with pytest.raises(tb.ScenarioError, match="honoured only by method = 'dopri5', 'ros34pw2'; "
+                       "solver = 'reduced' with method 'dopri5' ignores it"):
+        tb.Scenario.from_dict({"tolerance_pin_velocity": 1e-5})
+
+
 def test_a_toy_solver_runs_through_simulate(toys):
     """The toy RK4 (fixed step 1e-4 s) follows dopri5 on flat ground; the outputs name it."""
     ds = tb.simulate(tb.Scenario.from_dict({**FLAT, "solver": "toy"}))

@@ -7,7 +7,7 @@ import math
 
 from trackbench.model.contact.laws import DAMPING_LAWS
 from trackbench.scenario.presets import PRESETS, preset_values
-from trackbench.solvers.registry import SOLVERS, all_methods
+from trackbench.solvers.registry import SOLVERS, all_methods, pin_tolerance_methods
 
 from . import ScenarioError
 from .check_values import flatten, set_dotted
@@ -53,13 +53,22 @@ def check_sampling(out):
 
 def check_solver(d):
     """solver names an entry of the registry as it is now (a solver registered at run time
-    validates too), and method one of its methods (of any solver's where it has no choice)."""
+    validates too), and method one of its methods (of any solver's where it has no choice);
+    tolerance_pin_velocity only with a method that honours it (its entry's pin_tolerance_methods)."""
     if d["solver"] not in SOLVERS:
         raise ScenarioError(f"solver = {d['solver']!r} is not allowed: expected one of {', '.join(SOLVERS)}")
-    methods = SOLVERS[d["solver"]].methods or all_methods()
+    entry = SOLVERS[d["solver"]]
+    methods = entry.methods or all_methods()
     if d["method"] not in methods:
         allowed = ", ".join(sorted(methods))
         raise ScenarioError(f"method = {d['method']!r} is not allowed: expected one of {allowed}")
+    method = entry.method_of(d["method"])
+    if "tolerance_pin_velocity" in d and method not in entry.pin_tolerance_methods:
+        honour = ", ".join(repr(m) for m in pin_tolerance_methods()) or "no method"
+        raise ScenarioError(
+            f"tolerance_pin_velocity is honoured only by method = {honour}; solver = {d['solver']!r} "
+            f"with method {method!r} ignores it: remove it or choose such a method"
+        )
 
 
 def check_extensions(d, explicit):

@@ -37,6 +37,7 @@ class SolverEntry:
     streams: bool = False  # whether run() takes a sink: a long run streamed in chunks (run/stream.py)
     settings: str = ""  # the scenario table of its own settings ("lee": lee.accel_order, ...), "" none
     setting_rules: tuple = ()  # that table's Settings: defaults, rules and units
+    pin_tolerance_methods: tuple = ()  # its methods whose error norm honours tolerance_pin_velocity
 
     def module_for(self, method):
         return dict(self.method_modules).get(method, self.module)
@@ -96,6 +97,7 @@ SOLVERS = {
             closed_track=True,
             extended_models=True,
             streams=True,
+            pin_tolerance_methods=("ros34pw2",),
         ),
         SolverEntry(
             "lee",
@@ -117,6 +119,11 @@ def all_methods():
 
 # every method any solver takes at import (the parameter table's text)
 METHODS = all_methods()
+
+
+def pin_tolerance_methods():
+    """Every method whose error norm honours tolerance_pin_velocity (any solver's), sorted."""
+    return tuple(sorted({m for e in SOLVERS.values() for m in e.pin_tolerance_methods}))
 
 
 def settings_tables():
