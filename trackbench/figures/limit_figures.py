@@ -118,6 +118,10 @@ def _quantity_figure(summary, limits, axes, search, out, plt):
     ax.set_ylabel(f"{quantity} ({unit})" if unit else quantity)
     if len(failed):
         ax.scatter([], [], marker="x", color="grey", label="failed over the limit (when it stopped)")
+    values = np.append(done[quantity].to_numpy(float) / scale, limit)
+    values = values[np.isfinite(values)]
+    if values.size and values.min() > 0.0 and values.max() > 20.0 * values.min():
+        ax.set_yscale("log")   # runs far over the limit would squash the ones near it
     ax.set_title(f"{quantity} of every run of the search (ringed: the run at the limit)", fontsize=10)
     return _saved(fig, ax, Path(out) / f"search_{quantity}.png", plt, 7)
 
