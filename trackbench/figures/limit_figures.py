@@ -49,6 +49,7 @@ def _limit_curve(limits, axes, search, out, plt):
     name, quantity = search["parameter"], search["quantity"]
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     x_name = axes[0] if axes else None
+    named = {}   # (x, limit): the runs at it
     for k, (label, rows) in enumerate(_lines(limits, axes)):
         rows = rows.sort_values(x_name) if x_name else rows
         xs = rows[x_name].to_numpy(float) if x_name else np.zeros(len(rows))
@@ -64,7 +65,9 @@ def _limit_curve(limits, axes, search, out, plt):
         if "limit_run" in rows:
             for x, y, run in zip(xs, rows["search_value"], rows["limit_run"]):
                 if isinstance(run, str) and np.isfinite(y):
-                    ax.annotate(run, (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
+                    named.setdefault((x, y), []).append(run)
+    for (x, y), runs in named.items():   # seeds at one limit: their runs one above another
+        ax.annotate("\n".join(runs), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=7)
     for status, (marker, text) in _STATUS_MARK.items():
         if (limits["status"] == status).any():
             ax.scatter([], [], marker=marker, color="grey", label=text)

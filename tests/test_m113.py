@@ -1,6 +1,7 @@
-"""`trackbench vehicle show m113`'s side view: what it draws is where the statics put it, and
-it can be seen in the PNG (each part's fill colour at its centre's pixel, not hidden by
-another part)."""
+"""The M113 at rest: `trackbench vehicle show m113`'s side view (what it draws is where the
+statics put it, and it can be seen in the PNG: each part's fill colour inside it, not hidden by
+another part), and the rear idler's clearance that sets its obstacle-limited speed's cliff
+between half-rounds of 6 and 8 in (docs/validation.md, "The M113")."""
 
 import numpy as np
 import pytest
@@ -98,3 +99,16 @@ def test_each_part_can_be_seen(m113, drawn):
     assert tuple(_pixel(ax, image, (0.0, -0.05))) != (255, 255, 255)     # the ground's fill
     hull_x = 0.5 * (m113.wheels[0, 0] + m113.wheels[1, 0])
     assert tuple(_pixel(ax, image, (hull_x, 1.6))) == (233, 237, 242)     # the hull's fill
+
+
+def test_the_track_under_the_idler_clears_6_in_and_not_8_in(m113):
+    """The track's underside below the idler's centre at rest: above a 6 in half-round's top,
+    below an 8 in one's, so the larger half-rounds strike the idler (which has no suspension)."""
+    from trackbench.run.vehicle_report import closed_drawing
+
+    sc = m113.scenario
+    x, y, r = closed_drawing(m113)["idler"]
+    near = m113.pins[np.abs(m113.pins[:, 0] - x) < sc["track.link_length"]]
+    underside = near[:, 1].min() - sc["track.pad_ground"]
+    assert y - r - sc["track.pad_wheel"] > underside > 0.0     # the track below the idler
+    assert 6 * 0.0254 < underside < 8 * 0.0254, underside
