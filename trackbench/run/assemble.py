@@ -286,7 +286,7 @@ class Model:
         self.arrays = model_arrays(
             par, arms, ends, ground.segments, ground.corners, self.n_links, loop, guides, rut
         )
-        self.work = work_arrays(self.arrays, self.nw, self.n_links)
+        self.work = work_arrays(self.arrays, self.nw, self.n_links, at_rest=False)
         self.weight = eq.weight if self.closed else total_mass(v, tr) * scenario["gravity"]
         self.nq = int(self.arrays.pins[L.PN_NQ])
         self.ny = int(self.arrays.pins[L.PN_NY])   # the state's length

@@ -97,8 +97,10 @@ def model_arrays(par, arms, ends, seg, corners, n_links, loop=None, guides=None,
                        np.full((n_links + 1, 2), np.nan))
 
 
-def work_arrays(m, n_wheels, n_links):
-    """Work for the paper's layout, ClosedWork for the closed one (m.pins says which)."""
+def work_arrays(m, n_wheels, n_links, at_rest=True):
+    """Work for the paper's layout, ClosedWork for the closed one (m.pins says which).
+    at_rest: room for the closed layout's generalised forces at rest (genf), which only the
+    static equilibrium reads; without it (a run's) the evaluations skip them."""
     n_pins = n_links + 1
     closed = bool(m.pins[L.PN_CLOSED])
     base = (np.zeros((n_pins, 2)), np.zeros((n_pins, 2)), np.zeros((n_pins, 2)),
@@ -111,7 +113,7 @@ def work_arrays(m, n_wheels, n_links):
     ng = m.guides.shape[0]
     nq = L.n_coordinates(n_wheels, n_links, closed=True)
     return ClosedWork(*base, np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros((ng, 2)), np.zeros(L.N_SP),
-                    np.zeros((2, ARM_COLS + 1)), np.zeros(nq))
+                    np.zeros((2, ARM_COLS + 1)), np.zeros(nq if at_rest else 0))
 
 
 # The closed layout's scratch: Work, then the idler and rollers as Work has the road wheels,
@@ -123,7 +125,8 @@ ClosedWork = namedtuple("ClosedWork", list(Work._fields) + [
     "spr",        # (N_SP,) sprocket kinematics in, loads out (SP_*)
     "extra",      # (2, ARM_COLS + 1) the sprocket's and the idler's rows of the mass matrix, as
                   # Work.arm's, with their own diagonal mass in column ARM_COLS
-    "genf",       # (nq,) out: generalised forces at rest (no inertia terms) for the equilibrium
+    "genf",       # (nq,) out: generalised forces at rest (no inertia terms) for the equilibrium;
+                  # (0,) in a run's Work: not computed
 ])
 LOOP_SPROCKET, LOOP_IDLER = 0, 1   # rows of ClosedWork.extra
 

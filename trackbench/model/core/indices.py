@@ -227,7 +227,11 @@ LP_HITCH_X = LP_DRAWBAR_LOAD + 1   # body point of the hitch (m)
 LP_HITCH_Y = LP_DRAWBAR_LOAD + 2
 LP_RIG_SLIP = LP_DRAWBAR_LOAD + 3  # slip the towing rig sets (0: no rig)
 LP_RIG_DAMPING = LP_DRAWBAR_LOAD + 4   # dashpot of the rig's carriage on the hitch (N s/m)
-N_LOOP = LP_RIG_DAMPING + 1
+# the tooth profile's constants (teeth_jit.tooth_shape of the values above), computed once when
+# the vector is built rather than in every evaluation of the pin-tooth contacts
+LP_SHAPE = LP_RIG_DAMPING + 1
+N_SHAPE = 13
+N_LOOP = LP_SHAPE + N_SHAPE
 
 # drive.kind codes (model/vehicle/drive.py)
 DRIVE_NONE, DRIVE_TORQUE, DRIVE_SPEED = 0, 1, 2

@@ -91,7 +91,7 @@ from ..ground.ground_contact import ground_contacts
 from ..vehicle.drive import drawbar_on_chassis, drive_torque, has_drawbar, held_speed
 from ..vehicle.kinematics import body_offset, place_wheels, wheel_velocities
 from ..vehicle.links import link_tensions
-from ..vehicle.teeth_jit import pin_on_teeth, tooth_shape
+from ..vehicle.teeth_jit import pin_on_teeth, stored_shape
 from .reduced import (
     chassis_acceleration,
     chassis_and_arms,
@@ -209,7 +209,7 @@ def _teeth(w, m, diag):
     law = (int(par[P_CONTACT_LAW]), DAMPING_VISCOUS if c > 0.0 else DAMPING_NONE, lp[LP_TOOTH_STIFFNESS],
            par[P_CONTACT_EXPONENT], c, 0.0, par[P_DAMPING_RAMP])
     om = spr[SP_RATE]
-    shape = tooth_shape(lp)
+    shape = stored_shape(lp)
     fx = fy = torque = energy = power = dissipation = 0.0
     for b in range(1, apos.shape[0]):
         dx = apos[b, 0] - spr[SP_X]
@@ -326,7 +326,7 @@ def _forces_at_rest(f, w, nw, n, genf):
 @njit(**BORROW)
 def closed_rhs(y, m, w, ydot, diag):
     """ydot = f(y) for the closed layout (reduced.reduced_rhs for the paper's); fills diag
-    and w.genf."""
+    and w.genf (where it has room: the equilibrium's Work)."""
     par, arms, lp = m.par, m.arms, m.loop
     nq = m.pins[PN_NQ]
     q = y[:nq]
@@ -363,7 +363,9 @@ def closed_rhs(y, m, w, ydot, diag):
     da, df, ke_idler, eg_idler = _idler(q, qd, m, w, c, s, tension_force)
     a = (a[0] + da[0], a[1], a[2] + da[2], a[3] + da[3], a[4] + da[4], a[5] + da[5] + inertia)
     f = (f[0] + df[0], f[1] + df[1], f[2] + df[2])
-    _forces_at_rest(f, w, nw, n, w.genf)
+    at_rest = w.genf.shape[0] > 0   # the equilibrium's Work: it reads the forces at rest
+    if at_rest:
+        _forces_at_rest(f, w, nw, n, w.genf)
     a, f = take_out_rows(w.extra, 0.0, ARM_D, a, f)   # the sprocket's and the idler's rows
     acc3 = chassis_acceleration(w.arm, a, f)
     acc = start_rates(ydot, qd, nq, acc3)
@@ -372,7 +374,7 @@ def closed_rhs(y, m, w, ydot, diag):
     for r, k in ((LOOP_SPROCKET, i_spr), (LOOP_IDLER, i_idl)):
         acc[k] = row_acceleration(w.extra, r, w.extra[r, ARM_D], acc3)
     ke, e_grav = pin_accelerations(par, nw, n, w.apos, w.avel, w.fpin, acc, ke + ke_idler, e_grav + eg_idler)
-    for b in range(1, n + 1):   # pins at rest: their forces for the equilibrium
+    for b in range(1, n + 1 if at_rest else 1):   # pins at rest: their forces for the equilibrium
         k = q_pin(nw, b)
         w.genf[k] = acc[k] * par[P_PIN_MASS]
         w.genf[k + 1] = acc[k + 1] * par[P_PIN_MASS]

@@ -262,6 +262,9 @@ def closed_vector(g, spr, idl, drive, contact_c, drawbar=None):
         lp[L.LP_HITCH_X], lp[L.LP_HITCH_Y] = drawbar["hitch"]
         lp[L.LP_RIG_SLIP] = drawbar["slip"]
         lp[L.LP_RIG_DAMPING] = drawbar["rig_damping"]
+    from .teeth_jit import tooth_shape  # numba: loaded when first needed
+
+    lp[L.LP_SHAPE:L.LP_SHAPE + L.N_SHAPE] = tooth_shape(lp)
     return lp
 
 

@@ -22,6 +22,7 @@ from ..core.indices import (
     LP_PIN_RADIUS,
     LP_PITCH_RADIUS,
     LP_SEAT_RADIUS,
+    LP_SHAPE,
     LP_TEETH,
     LP_TIP_RADIUS,
 )
@@ -44,10 +45,11 @@ def _nearer(best, bx, by, px, py, qx, qy):
 
 @njit(**INLINE)
 def tooth_shape(lp):
-    """The profile's constants, once per evaluation rather than once per pin (they took
-    most of the teeth's time): (r_g, r_t, r_pin, r_s, pitch angle, the flank's direction cos
-    and sin alpha, tan alpha, the flank's length, then the tip arc's ends, the flank's
-    corner and the half pitch, as cos and sin of their angles)."""
+    """The profile's constants, once per profile rather than once per pin (they took most
+    of the teeth's time; closed_track.closed_vector stores them in the LP_* vector, where
+    the contact kernel reads them, stored_shape): (r_g, r_t, r_pin, r_s, pitch angle, the
+    flank's direction cos and sin alpha, tan alpha, the flank's length, then the tip arc's
+    ends, the flank's corner and the half pitch, as cos and sin of their angles)."""
     rg = lp[LP_SEAT_RADIUS]
     rt = lp[LP_TIP_RADIUS]
     rpin = lp[LP_PIN_RADIUS]
@@ -59,6 +61,15 @@ def tooth_shape(lp):
     s_corner, c_corner = fm.sincos(fm.atan2(rg + t_end * sa, rs + t_end * ca))
     s_half, c_half = fm.sincos(0.5 * pitch)
     return rg, rt, rpin, rs, pitch, ca, sa, fm.tan(alpha), t_end, c_corner, s_corner, c_half, s_half
+
+
+@njit(**INLINE)
+def stored_shape(lp):
+    """tooth_shape(lp) as closed_track.closed_vector stored it in lp (LP_SHAPE on): the
+    contact kernel reads the constants instead of computing them in every evaluation."""
+    s = LP_SHAPE
+    return (lp[s], lp[s + 1], lp[s + 2], lp[s + 3], lp[s + 4], lp[s + 5], lp[s + 6], lp[s + 7], lp[s + 8],
+            lp[s + 9], lp[s + 10], lp[s + 11], lp[s + 12])
 
 
 @njit(**INLINE)
