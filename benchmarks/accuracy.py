@@ -25,7 +25,6 @@ changes included) and the toolchain.
 import hashlib
 import json
 import math
-import subprocess
 import time
 from pathlib import Path
 
@@ -46,23 +45,14 @@ NOT_THE_REFERENCE = ("solvers/rosenbrock/", "solvers/imex/", "solvers/lee/", "so
                      "solvers/registry.py", "cli/", "figures/", "study/", "warm/")
 
 
-def _git(*args):
-    pkg = Path(tb.__file__).resolve().parent
-    try:
-        done = subprocess.run(["git", "-C", str(pkg), *args], capture_output=True, text=True, check=True)
-        return done.stdout
-    except (OSError, subprocess.CalledProcessError):
-        return ""
-
-
 def _code_key():
     """The trees of trackbench/'s folders a dopri5 run reads, and their uncommitted changes."""
     from trackbench.version import MODEL_VERSION, __version__, toolchain
 
-    ls = [line.split("\t", 1) for line in _git("ls-tree", "-r", "HEAD", ".").splitlines()]
+    ls = [line.split("\t", 1) for line in wp._git("ls-tree", "-r", "HEAD", ".").splitlines()]
     kept = [f"{blob}\t{path}" for blob, path in ls if not path.startswith(NOT_THE_REFERENCE)]
     paths = [line.split("\t", 1)[1] for line in kept]
-    diff = _git("diff", "HEAD", "--", *paths) if paths else ""
+    diff = wp._git("diff", "HEAD", "--", *paths) if paths else ""
     return {
         "model_version": MODEL_VERSION,
         "tree": hashlib.sha256("\n".join(kept).encode()).hexdigest()[:16] if kept else __version__,
