@@ -46,20 +46,6 @@ REST_ITERATIONS = 100
 REST_STEP = 0.035   # rad (2 deg)
 
 
-def carried_at(vehicle, moment):
-    """The arm angles at which each torsion bar, twisted from its free angle (bump stops
-    included), balances the given moment of the loads about its pivot (N m)."""
-    cols = station_columns(vehicle, {"pad_wheel": 0.0})
-    kt, ks = cols[L.ARMS_STIFFNESS], cols[L.ARMS_STOP_K]
-    phi0 = free_angle(vehicle)
-    phi = phi0 + moment / kt
-    for stop, beyond in ((cols[L.ARMS_JOUNCE], phi < cols[L.ARMS_JOUNCE]),
-                         (cols[L.ARMS_REBOUND], phi > cols[L.ARMS_REBOUND])):
-        on = beyond & (ks > 0.0)   # on the stop: both springs
-        phi[on] = (moment[on] + kt[on] * phi0[on] + ks[on] * stop[on]) / (kt[on] + ks[on])
-    return phi
-
-
 def resting_vehicle(scenario):
     """The scenario's vehicle with its arms at rest: itself, unless it gives the torsion bars'
     free angles (vehicle.torsion_free_angle); then arm_angle holds the rest angles the
