@@ -8,7 +8,13 @@ from trackbench.model.ground.soil import SOIL_CHOICES
 from trackbench.outputs.quantities import accounted_balance
 from trackbench.outputs.variables import scenario_of
 from trackbench.scenario import RULES, UNITS, Scenario, ScenarioError, flatten, paper_step
-from trackbench.scenario.parameters_table import RANDOM_DEFAULTS, TERRAIN_KINDS, TERRAIN_RULES
+from trackbench.scenario.check_run import driven_model
+from trackbench.scenario.parameters_table import (
+    CLOSED_TOLERANCE,
+    RANDOM_DEFAULTS,
+    TERRAIN_KINDS,
+    TERRAIN_RULES,
+)
 from trackbench.scenario.presets import PRESETS, preset_values
 
 
@@ -68,6 +74,10 @@ def _integrator(ds):
     text = f"{a['solver']} {a['method']} at tolerance {a['tolerance']:g}"
     if "tolerance_pin_velocity" in ds:
         text += f" (pins' velocities {float(ds.tolerance_pin_velocity):g})"
+    model = driven_model(scenario_of(ds))
+    if model is not None and a["tolerance"] == CLOSED_TOLERANCE[model]:
+        ground = "soft soil" if model == "soil" else f"{model} friction"
+        text += f" (the closed track's default on {ground}; `tolerance` sets another)"
     return text
 
 

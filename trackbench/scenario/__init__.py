@@ -19,7 +19,14 @@ class ScenarioError(ValueError):
 
 # below ScenarioError: the check modules import it from this package
 from .check_closed import check_closed  # noqa: E402
-from .check_run import apply_preset, apply_sampling, check_extensions, check_sampling, check_solver  # noqa: E402
+from .check_run import (  # noqa: E402
+    apply_preset,
+    apply_sampling,
+    apply_tolerance,
+    check_extensions,
+    check_sampling,
+    check_solver,
+)
 from .check_terrain import check_placed_by_time, validate_terrain  # noqa: E402
 from .check_values import check_value, dotted_keys, flatten, merge, set_dotted, unknown  # noqa: E402
 from .check_vehicle import check_arm_stops, check_geometry  # noqa: E402
@@ -103,6 +110,7 @@ class Scenario:
         d["preset"] = check_value("preset", d.get("preset"), RULES["preset"])
         apply_sampling(d, explicit)   # first: the paper preset's step cap follows the output interval
         apply_preset(d, explicit | given)
+        apply_tolerance(d, explicit | given)   # last: it reads the preset, layout and ground
         return cls(validate(d, explicit | given), explicit, given, folder)
 
     def with_overrides(self, overrides: Mapping[str, Any]) -> "Scenario":

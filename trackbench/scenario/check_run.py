@@ -11,7 +11,13 @@ from trackbench.solvers.registry import SOLVERS, all_methods, pin_tolerance_meth
 
 from . import ScenarioError
 from .check_values import flatten, set_dotted
-from .parameters_table import RIDE_KINDS, RIDE_OUTPUT_INTERVAL, paper_step
+from .parameters_table import (
+    CLOSED_TOLERANCE,
+    CLOSED_TOLERANCE_METHOD,
+    RIDE_KINDS,
+    RIDE_OUTPUT_INTERVAL,
+    paper_step,
+)
 
 
 def apply_preset(d, explicit):
@@ -36,6 +42,24 @@ def apply_sampling(d, explicit):
         d["output_interval"] = RIDE_OUTPUT_INTERVAL if ride else paper["output_interval"]
     if "record.every" not in explicit and isinstance(d.get("record"), dict):
         d["record"]["every"] = 0 if ride else paper["record"]["every"]
+
+
+def driven_model(d):
+    """The CLOSED_TOLERANCE key of a resolved scenario dict whose tolerance the closed track's
+    default sets (closed layout, damped preset, dopri5), else None."""
+    track, contact, terrain = (d.get(k) if isinstance(d.get(k), dict) else {} for k in ("track", "contact", "terrain"))
+    if not (track.get("layout") == "closed" and d.get("preset") == "damped"
+            and d.get("method") == CLOSED_TOLERANCE_METHOD):
+        return None
+    return "soil" if terrain.get("soil", "rigid") != "rigid" else contact.get("friction_law")
+
+
+def apply_tolerance(d, explicit):
+    """The closed track's default tolerance for its driven model (parameters_table.
+    CLOSED_TOLERANCE) where the scenario sets none; else the paper's."""
+    if "tolerance" in explicit:
+        return
+    d["tolerance"] = CLOSED_TOLERANCE.get(driven_model(d), paper_step()["tolerance"])
 
 
 def check_sampling(out):
