@@ -47,7 +47,8 @@ def apply_sampling(d, explicit):
 def driven_model(d):
     """The CLOSED_TOLERANCE key of a resolved scenario dict whose tolerance the closed track's
     default sets (closed layout, damped preset, dopri5), else None."""
-    track, contact, terrain = (d.get(k) if isinstance(d.get(k), dict) else {} for k in ("track", "contact", "terrain"))
+    track, contact, terrain = (d.get(k) if isinstance(d.get(k), dict) else {}
+                               for k in ("track", "contact", "terrain"))
     if not (track.get("layout") == "closed" and d.get("preset") == "damped"
             and d.get("method") == CLOSED_TOLERANCE_METHOD):
         return None
