@@ -89,6 +89,9 @@ def _prepared(scenario):
 @pytest.mark.parametrize("overrides", [
     {"terrain": {"kind": "flat"}, "duration": 5.0},                                       # dopri5, 2 chunks
     {"preset": "damped", "duration": 0.3, "output_interval": 5e-5, "method": "ark436l2sa"},  # IMEX, 2 chunks
+    # the closed track: dopri5's PI controller carries the last error over the pause
+    {"preset": "damped", "track.layout": "closed", "drive.kind": "speed", "duration": 0.25,
+     "output_interval": 5e-5, "terrain": {"kind": "flat"}},
 ])
 def test_a_run_in_chunks_is_the_run_in_one_piece(overrides):
     """The loop pauses when its chunk is full and resumes with the same step: the samples,

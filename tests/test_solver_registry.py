@@ -123,9 +123,13 @@ def test_the_controls_are_built_once_from_the_scenario_by_the_entry():
     assert (c.t_end, c.dt_out, c.rtol, c.atol, c.max_steps) == (0.5, 1e-4, 1e-9, 1e-9, 1234)
     assert c.n_samples == 5001 and c.h_max == 1e-4 and c.h0 == 1e-5
     assert tuple(c.loop_control) == (c.t_end, c.dt_out, c.rtol, c.atol, c.h0, c.h_max, c.h_min,
-                                     c.max_steps, c.n_samples)
+                                     c.max_steps, c.n_samples, c.pi_beta)
     r = controls(tb.Scenario.from_dict({"method": "dop853"}))
     assert r.method == "dop853" and r.settings == {}
+    # the step controller: the plain one on the paper's layout (its golden runs), the PI one
+    # (Hairer's DOPRI5 exponent) on the closed track
+    assert c.pi_beta == r.pi_beta == 0.0
+    assert controls(tb.Scenario.from_dict({"track.layout": "closed"})).pi_beta == 0.04
 
 
 def test_a_solvers_own_settings_are_its_entrys():

@@ -12,9 +12,10 @@ entry says ``streams``, ``run(model, y0, controls, sink=None)``), where
 - ``controls`` is a ``Controls``, built once per run by the run layer from the validated
   scenario (registry.SolverEntry.controls): t_end, the output interval, the tolerances, the
   step limits (h0, h_max, h_min, max_steps), the number of samples, the method it runs, its
-  own settings table (``controls.settings``: e.g. lee's ``accel_order``) and the pins'
-  velocities' own tolerance where the scenario sets one; the compiled loops take its numeric
-  part, ``controls.loop_control`` (a ``Control``).
+  own settings table (``controls.settings``: e.g. lee's ``accel_order``), the pins'
+  velocities' own tolerance where the scenario sets one and the step controller
+  (``pi_beta``: the explicit pairs' loop steps by the PI controller where it is not 0); the
+  compiled loops take its numeric part, ``controls.loop_control`` (a ``Control``).
 
 The solver:
 
@@ -75,7 +76,7 @@ CHUNK_ROWS = 4096
 # Step control of a run as the compiled loops take it (numba reads the named tuple as one
 # argument): Controls.loop_control.
 Control = namedtuple("Control", ["t_end", "dt_out", "rtol", "atol", "h0", "h_max", "h_min", "max_steps",
-                                 "n_samples"])
+                                 "n_samples", "pi_beta"])
 
 
 # Filled by the compiled loops: samples on the output grid, peaks over every accepted step.
@@ -118,16 +119,19 @@ class Controls:
     # 0: not set, the method's default); the methods that read it say so in their registry entry
     # (contract point 3)
     tolerance_pin_velocity: float = 0.0
+    # the step controller: the PI controller's exponent on the previous error (solvers/common/
+    # control.py PI_BETA), 0: the plain controller; the explicit pairs' loop reads it
+    pi_beta: float = 0.0
 
     @property
     def loop_control(self):
         """The numeric part, as the compiled loops take it."""
         return Control(self.t_end, self.dt_out, self.rtol, self.atol, self.h0, self.h_max, self.h_min,
-                       self.max_steps, self.n_samples)
+                       self.max_steps, self.n_samples, self.pi_beta)
 
 
 def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, method="", settings=None,
-             tolerance_pin_velocity=0.0):
+             tolerance_pin_velocity=0.0, pi_beta=0.0):
     """The Controls of a run from its settings. The step is the error control's alone,
     whatever the output interval (samples come from the dense output), up to ``max_step``
     where one is set (0: none)."""
@@ -136,7 +140,7 @@ def controls(duration, output_interval, tolerance, max_step=0.0, max_steps=0, me
     h_max = min(float(max_step) or t_end, (CHUNK_ROWS - 1) * dt_out)
     return Controls(t_end, dt_out, float(tolerance), float(tolerance), min(H0, h_max), h_max, H_MIN,
                     step_cap(max_steps, t_end), n_samples(t_end, dt_out), method, dict(settings or {}),
-                    float(tolerance_pin_velocity or 0.0))
+                    float(tolerance_pin_velocity or 0.0), float(pi_beta))
 
 
 STEPS_PER_SECOND = 400_000   # max_steps = 0: the closed track with friction takes ~160,000 a second

@@ -58,7 +58,15 @@ class SolverEntry:
         own = dict(scenario[self.settings]) if self.settings else {}
         return controls(scenario["duration"], scenario["output_interval"], scenario["tolerance"],
                         scenario["max_step"], scenario["max_steps"], self.method_of(scenario["method"]), own,
-                        _optional(scenario, "tolerance_pin_velocity"))
+                        _optional(scenario, "tolerance_pin_velocity"), _pi_beta(scenario))
+
+
+def _pi_beta(scenario):
+    """The closed track steps by the PI controller (half the rejected steps of the plain one,
+    docs/benchmarks.md); the paper's layout keeps the plain one, bit for bit."""
+    from .common.control import PI_BETA
+
+    return PI_BETA if scenario["track"]["layout"] == "closed" else 0.0
 
 
 def _optional(scenario, name):

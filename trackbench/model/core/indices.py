@@ -430,4 +430,5 @@ RS_R_REF = 13
 RS_N_RHS = 14
 RS_AGE = 15       # the IMEX loop's: steps since its Jacobian, rejections in a row
 RS_IN_ROW = 16
-N_RUN_STATE = 17
+RS_ERR_OLD = 17   # the explicit pairs' PI controller: the last accepted step's error
+N_RUN_STATE = 18

@@ -13,6 +13,11 @@ from ...status import MAX_STEPS, STEP_SIZE_UNDERFLOW, SUCCESSFUL
 SAFETY = 0.9
 FAC_MIN = 0.2
 FAC_MAX = 10.0   # growth after an accepted step (1 right after a rejection)
+# The PI controller's exponent on the previous accepted step's error (Gustafsson's; Hairer &
+# Wanner II.4 (4.13), the value of their DOPRI5 code): the closed track's explicit pairs use it
+# (registry: controls), the paper's layout keeps the plain controller its golden runs pin.
+PI_BETA = 0.04
+ERR_OLD_MIN = 1e-4   # the previous error's floor (theirs): one tiny error does not fling h up
 
 
 @njit(**INLINE)
@@ -61,6 +66,17 @@ def after_acceptance(h, err, expo, fac_max, h_max):
     else:
         fac = min(fac_max, SAFETY * fm.pow(err, expo))
     return min(h * fac, h_max)
+
+
+@njit(**BORROW)
+def after_acceptance_pi(h, err, err_old, expo, beta, fac_max, h_max):
+    """The next step after an accepted one by the PI controller (beta > 0): err^(expo +
+    0.75 beta) x err_old^beta, the previous accepted step's error err_old >= ERR_OLD_MIN;
+    beta = 0: after_acceptance, bit for bit."""
+    if beta == 0.0:
+        return after_acceptance(h, err, expo, fac_max, h_max)
+    fac = SAFETY * fm.pow(max(err, 1e-10), expo + 0.75 * beta) * fm.pow(err_old, beta)
+    return min(h * min(fac_max, fac), h_max)
 
 
 @njit(**BORROW)

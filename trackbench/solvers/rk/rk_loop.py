@@ -13,13 +13,14 @@ import numpy as np
 from numba import njit
 
 from ...model.contact.onsets import onset_in_step
-from ...model.core.indices import N_Y_EXTRA, PN_NQ, RS_N_OUT
+from ...model.core.indices import N_Y_EXTRA, PN_NQ, RS_ERR_OLD, RS_N_OUT
 from ...model.core.jit import BORROW, INLINE
 from ...model.dynamics.rhs import rhs
 from ...status import SUCCESSFUL
 from ..common.control import (
+    ERR_OLD_MIN,
     FAC_MAX,
-    after_acceptance,
+    after_acceptance_pi,
     after_rejection,
     before_step,
     counted,
@@ -131,6 +132,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
     t, h, n_out, n_rhs = at
     steps, rejected, h_lo, h_hi, fac_max, at_switch = counts
     e_ref, r_ref = refs
+    err_old = max(out.resume[RS_ERR_OLD], ERR_OLD_MIN)   # the PI controller's (ctl.pi_beta)
     while status == SUCCESSFUL and t < t_end * (1.0 - 1e-14):
         status, h = before_step(t, h, t_end, steps, rejected, ctl.max_steps, h_min)
         if status != SUCCESSFUL:
@@ -138,6 +140,7 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         if chunk_full(t, h, n_out, ctl, out):   # a run streamed in chunks: hand this one over
             counts = (steps, rejected, h_lo, h_hi, fac_max, at_switch)
             keep_state(out.resume, (t, h, n_out, n_rhs), counts, refs)
+            out.resume[RS_ERR_OLD] = err_old
             return
         _stages(h, A, b, m, w, y, K, ys, y_new, diag)
         n_rhs += s
@@ -167,7 +170,8 @@ def integrate(y0, ctl, tab, m, w, ev, lw, out):
         n_rhs += n_new - n_out
         n_out = n_new
         t += h
-        h = after_acceptance(h, err, expo, fac_max, h_max)
+        h = after_acceptance_pi(h, err, err_old, expo, ctl.pi_beta, fac_max, h_max)
+        err_old = max(err, ERR_OLD_MIN)
         fac_max = FAC_MAX
     finish_stats(out.stats, status, t, steps, rejected, n_rhs, n_out, h_lo, h_hi)
     out.resume[RS_N_OUT] = n_out
