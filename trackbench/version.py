@@ -2,7 +2,7 @@
 model or the solvers changes results: study run ids include it)."""
 
 __version__ = "0.1.0"
-MODEL_VERSION = "5"
+MODEL_VERSION = "6"
 
 
 def toolchain():
