@@ -8,7 +8,7 @@ from trackbench.model.ground.soil import SOIL_CHOICES
 from trackbench.outputs.quantities import accounted_balance
 from trackbench.outputs.variables import scenario_of
 from trackbench.scenario import RULES, UNITS, Scenario, ScenarioError, flatten, paper_step
-from trackbench.scenario.check_run import driven_model
+from trackbench.scenario.check_run import closed_default
 from trackbench.scenario.parameters_table import (
     CLOSED_TOLERANCE,
     RANDOM_DEFAULTS,
@@ -74,10 +74,8 @@ def _integrator(ds):
     text = f"{a['solver']} {a['method']} at tolerance {a['tolerance']:g}"
     if "tolerance_pin_velocity" in ds:
         text += f" (pins' velocities {float(ds.tolerance_pin_velocity):g})"
-    model = driven_model(scenario_of(ds))
-    if model is not None and a["tolerance"] == CLOSED_TOLERANCE[model]:
-        ground = "soft soil" if model == "soil" else f"{model} friction"
-        text += f" (the closed track's default on {ground}; `tolerance` sets another)"
+    if closed_default(scenario_of(ds)) and a["tolerance"] == CLOSED_TOLERANCE:
+        text += " (the closed track's default; `tolerance` sets another)"
     return text
 
 

@@ -44,23 +44,20 @@ def apply_sampling(d, explicit):
         d["record"]["every"] = 0 if ride else paper["record"]["every"]
 
 
-def driven_model(d):
-    """The CLOSED_TOLERANCE key of a resolved scenario dict whose tolerance the closed track's
-    default sets (closed layout, damped preset, dopri5), else None."""
-    track, contact, terrain = (d.get(k) if isinstance(d.get(k), dict) else {}
-                               for k in ("track", "contact", "terrain"))
-    if not (track.get("layout") == "closed" and d.get("preset") == "damped"
-            and d.get("method") == CLOSED_TOLERANCE_METHOD):
-        return None
-    return "soil" if terrain.get("soil", "rigid") != "rigid" else contact.get("friction_law")
+def closed_default(d):
+    """Whether the closed track's default tolerance is a scenario dict's when it sets none:
+    the closed layout, the damped preset, dopri5."""
+    track = d.get("track") if isinstance(d.get("track"), dict) else {}
+    return (track.get("layout") == "closed" and d.get("preset") == "damped"
+            and d.get("method") == CLOSED_TOLERANCE_METHOD)
 
 
 def apply_tolerance(d, explicit):
-    """The closed track's default tolerance for its driven model (parameters_table.
-    CLOSED_TOLERANCE) where the scenario sets none; else the paper's."""
+    """The closed track's default tolerance (parameters_table.CLOSED_TOLERANCE) where the
+    scenario sets none and closed_default says so; else the paper's."""
     if "tolerance" in explicit:
         return
-    d["tolerance"] = CLOSED_TOLERANCE.get(driven_model(d), paper_step()["tolerance"])
+    d["tolerance"] = CLOSED_TOLERANCE if closed_default(d) else paper_step()["tolerance"]
 
 
 def check_sampling(out):
