@@ -3,7 +3,7 @@ Prints figures; asserts nothing. Takes several minutes.
 
     python benchmarks/bench_closed.py            # everything
     python benchmarks/bench_closed.py drive      # one part: rest, drive, profiles, traction, step, cost,
-                                                 # ratios, precision, spread, criterion, energy
+                                                 # ratios, long, precision, spread, criterion, energy
     python benchmarks/bench_closed.py precision --methods dopri5,dop853 --tolerances 1e-7,1e-8,1e-9
     python benchmarks/bench_closed.py energy --methods ros34pw2,dopri5 --tolerances 1e-5,1e-6,1e-7 \
         --pin-ratios 1,10
@@ -243,6 +243,29 @@ def ratios():
     against_the_paper(variants, REPEATS)
 
 
+def long(duration=20.0):
+    """The 20 s flat run (closed, damped, mu 0.6, speed drive 10 m/s, samples every 1 ms) at the
+    defaults with each friction law, one round beside the paper's model (paper_step at its
+    defaults, best of 3): wall time, its ratio per simulated second, the speed held over the
+    second half and the energy residual at the end and at most."""
+    paper = tb.Scenario.paper()
+    best_paper = min(best_walls({"paper": paper}, 3).values()) / paper["duration"]
+    print(f"\n| {duration:g} s flat run | method, tolerance | wall | x real time | / the paper model's | "
+          "steps (+ rejected) | speed held | residual end / max |\n" + "| --- " * 8 + "|")
+    for law in ("regularised", "bristle"):
+        sc = tb.Scenario.from_dict({**STEP, "contact.friction_law": law, "terrain": {"kind": "flat"},
+                                    "duration": duration, "output_interval": 1e-3})
+        t = time.perf_counter()
+        ds = tb.simulate(sc)
+        wall = time.perf_counter() - t
+        f = work_precision._figures(ds, sc, wall)
+        res = ds.energy_residual.values   # relative to E0
+        print(f"| {law} friction | {sc['method']}, {sc['tolerance']:g} | {wall:.1f} s | "
+              f"{wall / duration:.2f} | {wall / duration / best_paper:.1f}x | "
+              f"{f['steps']:,} (+{f['rejected']:,}) | "
+              f"{f['speed_hold']:.2%} | {res[-1]:.1e} / {f['energy']:.1e} |")
+
+
 PARTS = {
     "rest": rest,
     "drive": drive,
@@ -251,6 +274,7 @@ PARTS = {
     "step": step,
     "cost": cost,
     "ratios": ratios,
+    "long": long,
 }
 
 if __name__ == "__main__":
