@@ -209,3 +209,25 @@ def test_the_same_signal_gives_the_same_bits():
         return [rm.vdv(a, DT, 1.0), rm.absorbed_power(a, DT, 1.0), rm.peak_seat_acceleration_g(a, DT)]
 
     assert [v.hex() for v in metrics(a)] == [v.hex() for v in metrics(a.copy())]
+
+
+def test_a_stopped_run_gives_the_least_its_ride_figures_could_be():
+    """Of a run that stopped after k of its n samples, the second-half figures are over the
+    half it was to have, the samples it lacks counted as 0: never above the whole run's, never
+    falling as k grows, the whole run's at k = n, 0 before the half; the peak its own."""
+    t = DT * np.arange(20001)
+    a = 3.0 * np.sin(2 * np.pi * 4.0 * t) + 1.5 * np.sin(2 * np.pi * 11.0 * t + 0.3) * (t > 1.2)
+    n, settle = a.size, 0.5 * (a.size - 1) * DT
+    whole = rm.ride_figures(a, DT, settle)
+    keys = ("absorbed_power", "weighted_rms_acceleration", "vdv")
+    last = dict.fromkeys(keys, 0.0)
+    for k in (5000, 10000, 10001, 12000, 15000, 19999, 20001):
+        part = rm.ride_figures(a[:k], DT, settle, n)
+        for key in keys:
+            assert 0.0 <= part[key] <= whole[key] and part[key] >= last[key], (k, key)
+            last[key] = part[key]
+        if k <= 10000:
+            assert all(part[key] == 0.0 for key in keys)
+        assert part["peak_seat_acceleration_g"] == rm.peak_seat_acceleration_g(a[:k], DT)
+    assert all(last[key] == whole[key] for key in keys)
+    assert rm.ride_figures(a[:15000], DT, settle, n)["absorbed_power"] > 0.5 * whole["absorbed_power"]

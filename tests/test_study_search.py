@@ -132,6 +132,28 @@ def test_a_failed_run_with_a_maximum_already_over_the_limit_counts_as_over(monke
     assert limits.quantity_of(study, SimpleNamespace(run_id="over")) is None
 
 
+def test_a_failed_run_whose_ride_figure_is_already_over_the_limit_counts_as_over(monkeypatch):
+    """A stopped run's ride figures are the least the whole run's could be (ride_figures): a
+    track thrown on rough ground after the seat absorbed more than the limit over the half it
+    was to average is over it, in the search, the study's exit and the search figure alike."""
+    from types import SimpleNamespace
+
+    from trackbench.study.execute.runner import Outcome
+    from trackbench.study.read import limits
+    recs = {"thrown": {"status": "failed", "results": {"absorbed_power": 380.0, "mean_drawbar_pull": 9.0}},
+            "early": {"status": "failed", "results": {"absorbed_power": 0.0}}}
+    monkeypatch.setattr(limits.store, "read_run", lambda output, run_id: recs[run_id])
+    study = SimpleNamespace(output=None, search=spec(quantity="absorbed_power", limit=6.0), runs=[None] * 2)
+    assert limits.quantity_of(study, SimpleNamespace(run_id="thrown")) == 380.0
+    assert limits.quantity_of(study, SimpleNamespace(run_id="early")) is None
+    frame = pd.DataFrame({"run_id": ["a", "b"], "status": ["completed", "failed"],
+                          "absorbed_power": [4.0, 380.0]})
+    assert Outcome(study, summary=frame).problem() is None
+    # a mean of a signed quantity bounds nothing
+    study.search = spec(quantity="mean_drawbar_pull", limit=2.0)
+    assert limits.quantity_of(study, SimpleNamespace(run_id="thrown")) is None
+
+
 def test_a_search_study_with_only_decided_failures_exits_cleanly():
     """The run that failed over the limit is the search's answer: no problem line, no nonzero
     exit; a failure under the limit (unknown) still is one."""

@@ -12,6 +12,7 @@ from trackbench.model.vehicle.kinematics import place_samples
 from trackbench.outputs.closed import closed_attrs, closed_layout_vars, soil_vars
 from trackbench.outputs.variables import WH, K, P, T
 from trackbench.outputs.variables import var as _var
+from trackbench.solvers.base import n_samples
 from trackbench.solvers.registry import SOLVERS
 from trackbench.status import Result
 from trackbench.version import MODEL_VERSION, __version__, toolchain
@@ -104,9 +105,12 @@ def ride_variables(scenario, a, time):
     fig = dict.fromkeys(names, nan)
     peak_time = nan
     if dt <= 1.0 / MIN_RATE and a.shape[0] >= 2 and np.isfinite(a).all():
-        # the second half of the samples (time[-1] for a whole run; a chunk of a streamed run,
-        # stream.py, has the run's first sample in front and its own figures are not kept)
-        fig = ride_figures(a, dt, 0.5 * ((a.shape[0] - 1) * dt))
+        # the second half of the run's samples (a chunk of a streamed run, stream.py, has the
+        # run's first sample in front and its own figures are not kept); of a run that stopped
+        # early, the second half it was to have: its figures are then the least the whole
+        # run's could be (ride_figures)
+        n = max(a.shape[0], n_samples(scenario["duration"], dt))
+        fig = ride_figures(a, dt, 0.5 * ((n - 1) * dt), n)
         peak_time = float(time[fig.pop("peak_index")])
     return {
         "peak_seat_acceleration_g": _var((), fig["peak_seat_acceleration_g"], "1",

@@ -199,35 +199,47 @@ def legacy_lowpass(a, dt):
     return _filtered(a, dt, legacy_lowpass_sections, 0.0)[0]
 
 
-def _mean_square(y, start):
+def _mean_square(y, start, n=None):
+    """The mean of y^2 over the samples i >= start of a signal of n samples (default: y's); y
+    shorter than that (a run that stopped early): the samples it lacks count as 0, so the mean
+    of the whole signal is at least this (y^2 >= 0)."""
     from trackbench.outputs.metrics.ride_jit import sum_of_squares  # numba: loaded when first needed
 
-    return sum_of_squares(y, start) / (y.shape[0] - start)
+    n = y.shape[0] if n is None else n
+    return sum_of_squares(y, start) / (n - start) if start < y.shape[0] else 0.0
 
 
 def _dose(y, start, dt):
     """(sum of y^4 dt)^(1/4) over i >= start; the fourth root as two square roots (exact IEEE
-    operations)."""
+    operations). 0 when y ends before start (a run that stopped early: the dose only grows)."""
     from trackbench.outputs.metrics.ride_jit import sum_of_fourth_powers  # numba: loaded when first needed
 
+    if start >= y.shape[0]:
+        return 0.0
     return math.sqrt(math.sqrt(sum_of_fourth_powers(y, start) * dt))
 
 
-def ride_figures(a, dt, settle):
+def ride_figures(a, dt, settle, n=None):
     """Every ride metric of one seat acceleration at once (each filter run once): a dict of
     peak_seat_acceleration_g (over the whole signal), peak_index (the sample of that peak),
-    absorbed_power, weighted_rms_acceleration and vdv (over the samples at t >= settle)."""
+    absorbed_power, weighted_rms_acceleration and vdv (over the samples at t >= settle).
+    n: the samples of the whole run when a holds only its first ones (a run that stopped
+    early): then the three second-half figures are the least the whole run's could be, each
+    a mean or a dose of non-negative terms over which the samples it lacks count as 0 (0 when
+    it stopped before settle), as the peak is the least the whole run's could be."""
     from trackbench.outputs.metrics.ride_jit import max_abs  # numba: loaded when first needed
 
     low = legacy_lowpass(a, dt)
     peak = max_abs(low, 0)
-    absorbed, start = _filtered(a, dt, absorbed_power_sections, settle)
-    weighted, _ = _filtered(a, dt, wk_sections, settle)
+    n = a.shape[0] if n is None else n
+    start = _first_sample(n, dt, settle)
+    absorbed, _ = _filtered(a, dt, absorbed_power_sections, 0.0)
+    weighted, _ = _filtered(a, dt, wk_sections, 0.0)
     return {
         "peak_seat_acceleration_g": peak / G,
         "peak_index": int(np.flatnonzero(np.abs(low) == peak)[0]),
-        "absorbed_power": _mean_square(absorbed, start),
-        "weighted_rms_acceleration": math.sqrt(_mean_square(weighted, start)),
+        "absorbed_power": _mean_square(absorbed, start, n),
+        "weighted_rms_acceleration": math.sqrt(_mean_square(weighted, start, n)),
         "vdv": _dose(weighted, start, dt),
     }
 

@@ -46,8 +46,9 @@ class Outcome:
         return self.counts()[0]
 
     def _decided_failures(self):
-        """Failed runs a search counted as over its limit (limits.quantity_of: a maximum that
-        passed the limit before the run stopped): the search's answer, not a problem."""
+        """Failed runs a search counted as over its limit (limits.quantity_of: a maximum or a
+        ride figure that passed the limit before the run stopped): the search's answer, not a
+        problem."""
         from trackbench.study.read.limits import failed_over_limit
         s, df = self.study.search, self.summary
         if s is None or df is None:

@@ -16,18 +16,24 @@ LIMIT_COLUMNS = ["search_value", "status", "runs", "limit_run"]
 LIMITS_FILE = "limits.csv"
 
 
-def _is_maximum(name):
-    """A quantity that is the largest value over the run (it can only grow as the run goes)."""
-    return name.startswith(("peak_", "max_"))
+# the ride's second-half figures: of a run that stopped early, the least the whole run's could
+# be (outputs/metrics/ride.py ride_figures)
+RIDE_HALF = ("absorbed_power", "weighted_rms_acceleration", "vdv")
+
+
+def _bounded_below(name):
+    """A quantity that a run which stopped early gives as the least the whole run's could be:
+    a largest value over the run (it can only grow as the run goes) or a ride figure."""
+    return name.startswith(("peak_", "max_")) or name in RIDE_HALF
 
 
 def failed_over_limit(frame, quantity, limit):
-    """The rows of a summary whose run failed with a maximum already over the limit: runs
-    quantity_of counts as over it (a boolean Series; all False for a quantity that is no
-    maximum, or not in the summary)."""
+    """The rows of a summary whose run failed with a quantity bounded below (_bounded_below)
+    already over the limit: runs quantity_of counts as over it (a boolean Series; all False for
+    another quantity, or one not in the summary)."""
     import pandas as pd
 
-    if quantity not in frame or "status" not in frame or not _is_maximum(quantity):
+    if quantity not in frame or "status" not in frame or not _bounded_below(quantity):
         return pd.Series(False, index=frame.index)
     return (frame["status"].astype(str) == "failed") & (frame[quantity] > limit)
 
@@ -35,9 +41,10 @@ def failed_over_limit(frame, quantity, limit):
 def quantity_of(study, run):
     """The searched quantity of a run as the results folder has it: a number, None (the run
     failed, or gave no number) or search.PENDING (not run, or not finished). A failed run
-    whose quantity is a maximum already over the limit when it stopped counts with that
-    value: the rest of the run could only have raised it (a step too high at that speed
-    throws the idler off its guide after the seat has seen its 2.5 g)."""
+    whose quantity is bounded below (_bounded_below) and already over the limit counts with
+    that value: the rest of the run could only have raised it (a step too high at that speed
+    throws the idler off its guide after the seat has seen its 2.5 g; a track thrown on rough
+    ground after the seat has absorbed more than its 6 W over the half it was to average)."""
     if run is None:
         return S.PENDING
     rec = store.read_run(study.output, run.run_id)
@@ -46,7 +53,7 @@ def quantity_of(study, run):
     value = (rec.get("results") or {}).get(study.search.quantity)
     value = None if value is None else float(value)
     if rec.get("status") == "failed":
-        over = value is not None and _is_maximum(study.search.quantity) and value > study.search.limit
+        over = value is not None and _bounded_below(study.search.quantity) and value > study.search.limit
         return value if over else None
     if not store.is_completed(study.output, run.run_id):
         return S.PENDING

@@ -26,8 +26,9 @@ brackets a crossing (at most 1 + bisection_rounds() waves of runs in all). A run
 gives no number for the quantity, ends its point's search as failed (no value), unless the
 scan crossed the limit below it: the limit is decided below the first such run (a run over an
 obstacle too fast for the model to finish lies beyond the limit it is searched for, as it
-does in the shipped obstacle study). A value the callback cannot give yet (PENDING) leaves the
-point pending.
+does in the shipped obstacle study), or its quantity is one a stopped run bounds from below
+and that bound is over the limit (study/read/limits.py: a peak, a ride figure). A value the
+callback cannot give yet (PENDING) leaves the point pending.
 """
 
 import difflib
