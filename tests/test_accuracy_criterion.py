@@ -89,7 +89,7 @@ def test_the_closed_track_takes_its_measured_default_tolerance():
     def tol(over):
         return tb.Scenario.from_dict({**CLOSED, **over})["tolerance"]
 
-    assert CLOSED_TOLERANCE == 1e-7
+    assert CLOSED_TOLERANCE == 1e-8
     assert tol({}) == tol({"contact.friction_law": "bristle"}) == CLOSED_TOLERANCE
     assert tol({"terrain": {"kind": "flat", "soil": "lete_sand"}}) == CLOSED_TOLERANCE
     assert tol({"tolerance": 1e-9}) == 1e-9
@@ -117,7 +117,7 @@ def test_trackbench_run_says_which_default_tolerance_it_used():
                  "tolerance": sc["tolerance"]}
         return _integrator(xr.Dataset(attrs=attrs))
 
-    assert line({}) == ("reduced dopri5 at tolerance 1e-07 (the closed track's default; `tolerance` "
+    assert line({}) == ("reduced dopri5 at tolerance 1e-08 (the closed track's default; `tolerance` "
                         "sets another)")
     assert line({"tolerance": 1e-9}) == "reduced dopri5 at tolerance 1e-09"
 

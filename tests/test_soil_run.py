@@ -197,12 +197,14 @@ SOIL_STEP = {
 
 def test_soil_peaks_agree_over_tolerances_and_a_nudge():
     """The soil's memory follows each step's interpolant (solvers/common/sinkage.py), so the
-    peaks do not depend on where the steps happened to end: the default tolerance, ten times
-    tighter and a 1e-9 m nudge of the free pins agree within 1 % (with the memory moved from the
-    steps' end states alone: min chassis ay 6.3 % apart)."""
+    peaks do not depend on where the steps happened to end: tolerance 1e-9, ten times tighter
+    and a 1e-9 m nudge of the free pins agree within 1 % (with the memory moved from the steps'
+    end states alone: min chassis ay 6.3 % apart). At looser tolerances (1e-7: 1.3 % apart) the
+    least chassis acceleration, ill-conditioned on this run (its ensemble spreads it 2.3 %),
+    is judged as a range instead (benchmarks/bench_soil.py criterion)."""
     from trackbench.outputs.quantities import quantity_of, values
 
-    runs = [{}, {"tolerance": 1e-10}, {"perturbation": 1e-9, "seed": 1}]
+    runs = [{"tolerance": 1e-9}, {"tolerance": 1e-10}, {"tolerance": 1e-9, "perturbation": 1e-9, "seed": 1}]
     peaks = []
     for over in runs:
         ds = tb.simulate(tb.Scenario.from_dict({**SOIL_STEP, **over}))
