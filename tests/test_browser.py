@@ -212,11 +212,17 @@ def _free_port():
         return s.getsockname()[1]
 
 
+def _at_a_terminal():
+    """In the child: Ctrl-C's default action, as a command typed at a terminal has it (the
+    suite itself may run as a background job, whose children inherit SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _serving(rrd, port):
-    """`trackbench view RRD --web --port PORT` started; returns (process, lines printed) once
-    it says where to look."""
+    """`trackbench view RRD --web --port PORT` started as at a terminal; returns (process, lines
+    printed) once it says where to look."""
     proc = subprocess.Popen(CLI + ["view", str(rrd), "--web", "--port", str(port)], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, preexec_fn=_at_a_terminal)
     lines, deadline = [], time.monotonic() + 90
     while time.monotonic() < deadline:
         line = proc.stdout.readline()
