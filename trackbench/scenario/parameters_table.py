@@ -77,7 +77,7 @@ RULES = {
     # any text here: check_run.check_solver checks both against the registry
     "solver": (str, None, None, "one of " + ", ".join(SOLVERS)),
     "method": (str, None, None, "one of " + ", ".join(METHODS)),
-    "tolerance": (float, 1e-14, 1e-3, "a number in [1e-14, 1e-3]"),
+    "tolerance": (float, 1e-14, 1e-3, "a number in [1e-14, 1e-3]"),   # its defaults: CLOSED_TOLERANCE
     "output_interval": (float, 0.0, math.inf,
                         "a number > 0 (s; default 1e-4 on obstacles, 1e-3 on flat ground)"),
     "max_step": (float, 0.0, 1000.0, "a number in [0, 1000] s (0: no cap, the error control alone; "
@@ -324,6 +324,10 @@ OBSTACLE_KEYS = {
 # default"). The bolted track (the paper's model) keeps `tolerance`'s 1e-9.
 CLOSED_TOLERANCE = 1e-8
 CLOSED_TOLERANCE_METHOD = "dopri5"
+_TOLERANCES = [f"{t:g}".replace("e-0", "e-") for t in (paper_step()["tolerance"], CLOSED_TOLERANCE)]
+RULES["tolerance"] = RULES["tolerance"][:3] + (
+    f"a number in [1e-14, 1e-3] (default {_TOLERANCES[0]}; the closed track with the damped preset and "
+    f"{CLOSED_TOLERANCE_METHOD}: {_TOLERANCES[1]})",)
 
 
 # --- The pins' velocities' own tolerance (solvers/base.py: the error norm) --------------------
