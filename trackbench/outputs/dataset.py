@@ -97,11 +97,11 @@ def ride_variables(scenario, a, time):
     chunk (stream.py) gives them its whole history. NaN where they cannot be had: samples
     more than 1/250 s apart (the weightings reach 100 Hz), fewer than two, or not finite (a
     failed run)."""
-    from trackbench.outputs.metrics.ride import MIN_RATE, ride_figures
+    from trackbench.outputs.metrics.ride import MIN_RATE, SECOND_HALF, ride_figures
 
     dt = scenario["output_interval"]
     nan = float("nan")
-    names = ("peak_seat_acceleration_g", "absorbed_power", "weighted_rms_acceleration", "vdv")
+    names = ("peak_seat_acceleration_g", *SECOND_HALF)
     fig = dict.fromkeys(names, nan)
     peak_time = nan
     if dt <= 1.0 / MIN_RATE and a.shape[0] >= 2 and np.isfinite(a).all():

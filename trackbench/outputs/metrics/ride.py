@@ -37,6 +37,9 @@ import numpy as np
 G = 9.80665               # m/s^2 in one g (the spec's, and Chrono's 1 / 0.1019716213)
 FT_PER_M = 3.28084        # the spec's 1 m/s^2 = 3.28084 ft/s^2 (absorbed power's input)
 MIN_RATE = 250.0          # samples a second at least (dt <= 1/250 s)
+# the figures over the run's second half: of a run that stopped early, the least the whole
+# run's could be (ride_figures)
+SECOND_HALF = ("absorbed_power", "weighted_rms_acceleration", "vdv")
 
 LEGACY_CUTOFF = 30.0      # Hz, NRMM's obstacle criterion
 LEGACY_POLES = 4          # Chrono's GetLegacyAz: ChButterworth_Lowpass(4, step, 30.0)

@@ -16,15 +16,12 @@ LIMIT_COLUMNS = ["search_value", "status", "runs", "limit_run"]
 LIMITS_FILE = "limits.csv"
 
 
-# the ride's second-half figures: of a run that stopped early, the least the whole run's could
-# be (outputs/metrics/ride.py ride_figures)
-RIDE_HALF = ("absorbed_power", "weighted_rms_acceleration", "vdv")
-
-
 def _bounded_below(name):
     """A quantity that a run which stopped early gives as the least the whole run's could be:
     a largest value over the run (it can only grow as the run goes) or a ride figure."""
-    return name.startswith(("peak_", "max_")) or name in RIDE_HALF
+    from trackbench.outputs.metrics.ride import SECOND_HALF
+
+    return name.startswith(("peak_", "max_")) or name in SECOND_HALF
 
 
 def failed_over_limit(frame, quantity, limit):
